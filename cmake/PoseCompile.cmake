@@ -1,0 +1,40 @@
+# SPDX-License-Identifier: Apache-2.0
+# Project-wide compile settings: warnings, sanitizers, fuzzing.
+
+if(CMAKE_C_COMPILER_ID MATCHES "GNU|Clang")
+  set(POSE_WARNING_FLAGS -Wall -Wextra -Wshadow -Wstrict-prototypes -Wmissing-prototypes
+                         -Wno-unused-parameter)
+  if(POSE_WERROR)
+    list(APPEND POSE_WARNING_FLAGS -Werror)
+  endif()
+endif()
+
+# pose_target_warnings(<target>): the project's warning set on one of its own targets
+# (C sources only; C++ shims get -Wall -Wextra).
+function(pose_target_warnings target)
+  target_compile_options(${target} PRIVATE
+    $<$<COMPILE_LANGUAGE:C>:${POSE_WARNING_FLAGS}>
+    $<$<COMPILE_LANGUAGE:CXX>:-Wall -Wextra $<$<BOOL:${POSE_WERROR}>:-Werror>>)
+endfunction()
+
+if(POSE_SANITIZE AND POSE_TSAN)
+  message(FATAL_ERROR "POSE_SANITIZE and POSE_TSAN cannot be combined")
+endif()
+if(POSE_SANITIZE)
+  add_compile_options(-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
+  add_link_options(-fsanitize=address,undefined)
+endif()
+if(POSE_TSAN)
+  add_compile_options(-fsanitize=thread -fno-omit-frame-pointer)
+  add_link_options(-fsanitize=thread)
+endif()
+if(POSE_FUZZ)
+  if(NOT CMAKE_C_COMPILER_ID MATCHES "Clang")
+    message(FATAL_ERROR "POSE_FUZZ needs clang (CC=clang)")
+  endif()
+  # Instrument everything for coverage; the fuzzer main is linked only into fuzz targets.
+  add_compile_options(-fsanitize=fuzzer-no-link,address,undefined)
+  add_link_options(-fsanitize=address,undefined)
+endif()
+
+find_package(Threads REQUIRED)

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs dependencies, builds pose from scratch and runs the whole test
+# suite: a normal build (gcc), then the suite again under ASan+UBSan, then the
+# threaded tests under TSan. Exits non-zero on any failure.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+jobs=$(nproc)
+bash "$root/scripts/install-deps.sh"
+
+run_suite() { # <build dir> <label filter or ""> <cmake args...>
+  local dir=$1 filter=$2; shift 2
+  cmake -S "$root" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPOSE_BUILD_BENCH=OFF "$@" >/dev/null
+  cmake --build "$dir" -j "$jobs"
+  if [ -n "$filter" ]; then
+    ctest --test-dir "$dir" --output-on-failure -j "$jobs" -L "$filter"
+  else
+    ctest --test-dir "$dir" --output-on-failure -j "$jobs"
+  fi
+}
+
+echo "== build and test (gcc, RelWithDebInfo)"
+run_suite "$root/build" ""
+echo "== test under ASan+UBSan"
+run_suite "$root/build-asan" "" -DPOSE_SANITIZE=ON -DPOSE_BUILD_EXAMPLES=OFF
+echo "== threaded tests under TSan"
+run_suite "$root/build-tsan" "threads" -DPOSE_TSAN=ON -DPOSE_BUILD_EXAMPLES=OFF -DPOSE_BUILD_PREPROCESS=OFF

@@ -1,0 +1,379 @@
+/*
+ * pose — put a virtual patient's whole anatomy into any pose in real time.
+ * SPDX-License-Identifier: Apache-2.0
+ *
+ * This header is the contract: what is not declared here is not API.
+ *
+ * Quick start
+ * -----------
+ *     pose_rig *rig;
+ *     if (pose_rig_load("patient.rig", &rig) < 0) {
+ *         fprintf(stderr, "%s\n", pose_last_error());
+ *         return 1;
+ *     }
+ *     pose_state *st;
+ *     pose_state_create(rig, &st);
+ *     int knee = pose_rig_find_joint(rig, "knee_r");
+ *     const float bend[3] = {0.0f, 90.0f, 0.0f};
+ *     pose_set_joint_euler(st, knee, bend, POSE_EULER_XYZ); // POSE_CLAMPED if past limits
+ *     pose_set_method(st, POSE_COR);
+ *     pose_apply(st);
+ *     size_t n;
+ *     const float *xyz = pose_tissue_positions(st, 0, &n);  // n vertices, xyz interleaved
+ *     pose_state_free(st);
+ *     pose_rig_free(rig);
+ *
+ * Objects and threads
+ * -------------------
+ * A pose_rig is immutable once loaded: any number of threads may read it and
+ * create states from it at the same time. A pose_state is one posed patient;
+ * it must be used by one thread at a time (pose_apply itself fans work out to
+ * the state's own worker pool). A rig must outlive every state created from it.
+ *
+ * Errors
+ * ------
+ * Functions return a pose_status: POSE_OK (0) on success, POSE_CLAMPED (1) for
+ * a success that changed the request, a negative code on failure. After a
+ * failure, pose_last_error() returns a message that names what went wrong
+ * (file, section, offset, line). The message is thread-local: it belongs to
+ * the calling thread and stays valid until that thread's next pose call.
+ *
+ * Units and conventions
+ * ---------------------
+ * Lengths are in the rig's units (pose-bake writes metres). Quaternions are
+ * {x, y, z, w}. Matrices do not appear in the API: transforms are a rotation
+ * quaternion plus a translation, applied as p' = R p + t. Positions and normals
+ * are float triples interleaved (x0 y0 z0 x1 y1 z1 ...).
+ */
+#ifndef POSE_POSE_H
+#define POSE_POSE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "pose/export.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---------------------------------------------------------------- version */
+
+#define POSE_VERSION_MAJOR 0
+#define POSE_VERSION_MINOR 1
+#define POSE_VERSION_PATCH 0
+/** Encoded as MAJOR*10000 + MINOR*100 + PATCH. Same major = same ABI. */
+#define POSE_VERSION_NUMBER \
+    (POSE_VERSION_MAJOR * 10000 + POSE_VERSION_MINOR * 100 + POSE_VERSION_PATCH)
+
+/** Run-time version of the library, encoded as POSE_VERSION_NUMBER. @since 0.1 */
+POSE_API int pose_version(void);
+/** Run-time version as "MAJOR.MINOR.PATCH"; static storage. @since 0.1 */
+POSE_API const char *pose_version_string(void);
+
+/* ----------------------------------------------------------------- status */
+
+/** Result codes. Codes are only ever appended, never renumbered. */
+typedef enum pose_status {
+    POSE_OK = 0,                 /**< success */
+    POSE_CLAMPED = 1,            /**< success; a value was clamped to a joint limit */
+    POSE_ERR_INVALID_ARGUMENT = -1, /**< NULL pointer, index out of range, bad enum */
+    POSE_ERR_OUT_OF_MEMORY = -2, /**< an allocation failed */
+    POSE_ERR_IO = -3,            /**< a file could not be opened, read, mapped or written */
+    POSE_ERR_FORMAT = -4,        /**< malformed data (bad magic, truncation, bad section) */
+    POSE_ERR_VERSION = -5,       /**< the data's format version is not supported */
+    POSE_ERR_CHECKSUM = -6,      /**< a section's CRC32 does not match its bytes */
+    POSE_ERR_INVALID_DATA = -7,  /**< well-formed but inconsistent (index range, weights, hierarchy) */
+    POSE_ERR_UNSUPPORTED = -8,   /**< the rig lacks what was asked (e.g. CoR centres) */
+    POSE_ERR_NOT_FOUND = -9,     /**< a named joint, tissue or file entry does not exist */
+    POSE_ERR_THREAD = -10,       /**< a worker thread could not be started */
+} pose_status;
+
+/** Fixed English text for a status code; never NULL; static storage. @since 0.1 */
+POSE_API const char *pose_status_string(pose_status status);
+
+/**
+ * Detailed message for the calling thread's most recent failure (or clamp):
+ * never NULL, "" when there is none. Valid until the thread's next pose call.
+ * @since 0.1
+ */
+POSE_API const char *pose_last_error(void);
+
+/* ----------------------------------------------------------------- values */
+
+/** A rigid transform: p' = R(rotation) p + translation. */
+typedef struct pose_transform {
+    float rotation[4];    /**< unit quaternion {x, y, z, w} */
+    float translation[3];
+} pose_transform;
+
+/**
+ * Euler angle orders. Angles are always given per axis as {x, y, z} degrees;
+ * the order says how they compose: POSE_EULER_ZXY means R = Rz * Rx * Ry,
+ * i.e. intrinsic rotations about Z, then the new X, then the new Y — the
+ * convention of BVH channel lists ("Zrotation Xrotation Yrotation").
+ */
+typedef enum pose_euler_order {
+    POSE_EULER_XYZ = 0,
+    POSE_EULER_XZY = 1,
+    POSE_EULER_YXZ = 2,
+    POSE_EULER_YZX = 3,
+    POSE_EULER_ZXY = 4,
+    POSE_EULER_ZYX = 5,
+} pose_euler_order;
+
+/** Skinning method used to deform the tet mesh. */
+typedef enum pose_method {
+    POSE_LBS = 0, /**< linear blend skinning */
+    POSE_DQS = 1, /**< dual quaternion skinning (antipodality handled) */
+    POSE_COR = 2, /**< optimized centres of rotation (needs CoR data in the rig) */
+} pose_method;
+
+/** What a tissue surface is. */
+typedef enum pose_tissue_kind {
+    POSE_TISSUE_SKIN = 0,
+    POSE_TISSUE_BONE = 1,
+    POSE_TISSUE_MUSCLE = 2,
+    POSE_TISSUE_ORGAN = 3,
+    POSE_TISSUE_OTHER = 4,
+} pose_tissue_kind;
+
+/**
+ * Memory callbacks. A zeroed struct means malloc/free. alloc must return
+ * memory aligned to at least `align` (a power of two, at most 4096).
+ */
+typedef struct pose_allocator {
+    void *(*alloc)(size_t size, size_t align, void *user);
+    void (*free)(void *ptr, void *user);
+    void *user;
+} pose_allocator;
+
+/* ------------------------------------------------------------ rig loading */
+
+typedef struct pose_rig pose_rig;     /**< immutable, shareable across threads */
+typedef struct pose_state pose_state; /**< one posed instance; one thread at a time */
+
+/** Flags for pose_load_options.flags. */
+enum {
+    /** pose_rig_load_ex: read the file into memory instead of mapping it. */
+    POSE_LOAD_NO_MMAP = 1u << 0,
+    /** pose_rig_load_memory: use the caller's buffer in place (it must stay
+     *  valid and unchanged, and be 64-byte aligned, until pose_rig_free). */
+    POSE_LOAD_BORROW = 1u << 1,
+    /** skip CRC32 checks (structure is still fully validated). */
+    POSE_LOAD_SKIP_CRC = 1u << 2,
+};
+
+/** Options for loading; a zeroed struct gives the defaults. */
+typedef struct pose_load_options {
+    pose_allocator allocator;
+    uint32_t flags; /**< POSE_LOAD_* */
+} pose_load_options;
+
+/**
+ * Load a rig file (memory-mapped; every section validated before use).
+ * On failure *out is NULL and pose_last_error() names file, section and offset.
+ * @since 0.1
+ */
+POSE_API pose_status pose_rig_load(const char *path, pose_rig **out);
+/** pose_rig_load with options (NULL = defaults). @since 0.1 */
+POSE_API pose_status pose_rig_load_ex(const char *path, const pose_load_options *options,
+                                      pose_rig **out);
+/**
+ * Load a rig from a buffer holding a rig file's bytes. The bytes are copied
+ * unless options->flags has POSE_LOAD_BORROW. @since 0.1
+ */
+POSE_API pose_status pose_rig_load_memory(const void *data, size_t size,
+                                          const pose_load_options *options, pose_rig **out);
+/** Free a rig; NULL is a no-op. All states made from it must be freed first. @since 0.1 */
+POSE_API void pose_rig_free(pose_rig *rig);
+
+/* ---------------------------------------------------------- rig queries */
+
+/** Joint limit flags (pose_joint_info.limit_flags): bit a limits axis a (x=0,y=1,z=2). */
+enum { POSE_LIMIT_X = 1u, POSE_LIMIT_Y = 2u, POSE_LIMIT_Z = 4u };
+
+typedef struct pose_joint_info {
+    const char *name;          /**< owned by the rig */
+    int parent;                /**< -1 for a root; parents come before children */
+    pose_transform rest_model; /**< joint frame at rest, in model space */
+    pose_transform rest_local; /**< joint frame at rest, relative to the parent's */
+    uint32_t limit_flags;      /**< POSE_LIMIT_* bits */
+    pose_euler_order limit_order;  /**< order the limits' Euler angles are taken in */
+    float limit_min_deg[3];    /**< per axis {x, y, z}, in the joint's local frame */
+    float limit_max_deg[3];
+} pose_joint_info;
+
+typedef struct pose_tissue_info {
+    const char *name;            /**< owned by the rig */
+    pose_tissue_kind kind;
+    int joint;                   /**< joint a bone tissue belongs to, else -1 */
+    size_t vertex_count;
+    size_t triangle_count;
+    const float *rest_positions; /**< 3 * vertex_count, owned by the rig */
+    const uint32_t *triangles;   /**< 3 * triangle_count vertex indices, owned by the rig */
+} pose_tissue_info;
+
+/** The rig's tetrahedral mesh and its skinning data, all owned by the rig. */
+typedef struct pose_tet_info {
+    size_t vertex_count;
+    size_t tet_count;
+    const float *rest_positions; /**< 3 * vertex_count */
+    const uint32_t *tets;        /**< 4 * tet_count vertex indices */
+    const uint16_t *labels;      /**< per tet: 0 = soft tissue, j + 1 = bone of joint j */
+    unsigned influences;         /**< K weights per vertex (1..8) */
+    const uint16_t *weight_joints; /**< K * vertex_count joint indices */
+    const float *weights;        /**< K * vertex_count, >= 0, summing to 1 per vertex */
+    const float *cor;            /**< 3 * vertex_count centres of rotation, or NULL */
+} pose_tet_info;
+
+/** Number of joints. @since 0.1 */
+POSE_API size_t pose_rig_joint_count(const pose_rig *rig);
+/** Index of the joint with this exact name, or -1. @since 0.1 */
+POSE_API int pose_rig_find_joint(const pose_rig *rig, const char *name);
+/** Describe joint `joint`. @since 0.1 */
+POSE_API pose_status pose_rig_joint_info(const pose_rig *rig, int joint, pose_joint_info *out);
+/** Number of tissue surfaces. @since 0.1 */
+POSE_API size_t pose_rig_tissue_count(const pose_rig *rig);
+/** Index of the tissue with this exact name, or -1. @since 0.1 */
+POSE_API int pose_rig_find_tissue(const pose_rig *rig, const char *name);
+/** Describe tissue `tissue`. @since 0.1 */
+POSE_API pose_status pose_rig_tissue_info(const pose_rig *rig, int tissue, pose_tissue_info *out);
+/** Describe the tet mesh and weights. @since 0.1 */
+POSE_API pose_status pose_rig_tet_info(const pose_rig *rig, pose_tet_info *out);
+/** Free-form provenance text stored in the rig ("" when none); owned by the rig. @since 0.1 */
+POSE_API const char *pose_rig_metadata(const pose_rig *rig);
+
+/* ------------------------------------------------------- building rigs */
+
+/** One joint of a rig description. */
+typedef struct pose_joint_desc {
+    const char *name;          /**< 1..63 bytes, unique within the rig */
+    int parent;                /**< -1 for a root, else an earlier joint's index */
+    pose_transform rest_model; /**< joint frame at rest in model space */
+    uint32_t limit_flags;      /**< POSE_LIMIT_* */
+    pose_euler_order limit_order;
+    float limit_min_deg[3];
+    float limit_max_deg[3];
+} pose_joint_desc;
+
+/** One tissue surface of a rig description, embedded in the tet mesh. */
+typedef struct pose_tissue_desc {
+    const char *name;          /**< 1..63 bytes */
+    pose_tissue_kind kind;
+    int joint;                 /**< -1 unless a bone of that joint */
+    size_t vertex_count;
+    const float *positions;    /**< 3 * vertex_count rest positions */
+    size_t triangle_count;
+    const uint32_t *triangles; /**< 3 * triangle_count */
+    const uint32_t *tet;       /**< per vertex: index of the embedding tet */
+    const float *bary;         /**< 4 * vertex_count barycentric coordinates (sum 1;
+                                    may be slightly outside [0,1] for vertices
+                                    outside the tet mesh) */
+} pose_tissue_desc;
+
+/** Everything a rig holds, as caller-owned arrays (see pose_tet_info for layouts). */
+typedef struct pose_rig_desc {
+    size_t joint_count;
+    const pose_joint_desc *joints;
+    size_t tet_vertex_count;
+    const float *tet_positions;
+    size_t tet_count;
+    const uint32_t *tets;
+    const uint16_t *tet_labels;
+    unsigned influences;
+    const uint16_t *weight_joints;
+    const float *weights;
+    const float *cor;          /**< may be NULL: the rig then has no CoR method */
+    size_t tissue_count;
+    const pose_tissue_desc *tissues;
+    const char *metadata;      /**< may be NULL */
+} pose_rig_desc;
+
+/**
+ * Validate a description and build a rig from it (the arrays are copied).
+ * Applies the same checks as the loader. @since 0.1
+ */
+POSE_API pose_status pose_rig_create(const pose_rig_desc *desc, const pose_allocator *allocator,
+                                     pose_rig **out);
+/** Validate a description and write it as a rig file (current format version). @since 0.1 */
+POSE_API pose_status pose_rig_write_file(const pose_rig_desc *desc, const char *path);
+/**
+ * Validate a description and serialize it into a buffer allocated with
+ * `allocator` (NULL = malloc); the caller frees *data with the same allocator.
+ * @since 0.1
+ */
+POSE_API pose_status pose_rig_write_memory(const pose_rig_desc *desc, const pose_allocator *allocator,
+                                           void **data, size_t *size);
+
+/* ------------------------------------------------------------- instances */
+
+/** Options for a state; a zeroed struct gives the defaults. */
+typedef struct pose_state_options {
+    pose_allocator allocator;
+    int threads;        /**< worker threads for pose_apply; 0 = number of cores */
+    pose_method method; /**< initial method (default POSE_LBS) */
+} pose_state_options;
+
+/** Create a posed instance of `rig`, at rest. @since 0.1 */
+POSE_API pose_status pose_state_create(const pose_rig *rig, pose_state **out);
+/** pose_state_create with options (NULL = defaults). @since 0.1 */
+POSE_API pose_status pose_state_create_ex(const pose_rig *rig, const pose_state_options *options,
+                                          pose_state **out);
+/** Free a state and its worker pool; NULL is a no-op. @since 0.1 */
+POSE_API void pose_state_free(pose_state *state);
+/** The rig a state was made from. @since 0.1 */
+POSE_API const pose_rig *pose_state_rig(const pose_state *state);
+
+/**
+ * Set a joint's local rotation relative to its rest frame (quaternion
+ * {x,y,z,w}, normalized here). Returns POSE_CLAMPED if the rig's joint
+ * limits changed it (pose_last_error() says which axis and by how much).
+ * Takes effect at the next pose_apply. @since 0.1
+ */
+POSE_API pose_status pose_set_joint(pose_state *state, int joint, const float quat_xyzw[4]);
+/** Set a joint's local rotation from Euler angles {x,y,z} in degrees. @since 0.1 */
+POSE_API pose_status pose_set_joint_euler(pose_state *state, int joint, const float deg[3],
+                                          pose_euler_order order);
+/** The joint's current local rotation (after clamping). @since 0.1 */
+POSE_API pose_status pose_get_joint(const pose_state *state, int joint, float quat_xyzw[4]);
+/**
+ * Place the whole model: applied on top of the root joints' rest frames,
+ * p' = R p + t in model space. @since 0.1
+ */
+POSE_API pose_status pose_set_root(pose_state *state, const float translation[3],
+                                   const float quat_xyzw[4]);
+/** All joints back to rest, root transform to identity. @since 0.1 */
+POSE_API pose_status pose_reset(pose_state *state);
+/** Choose the skinning method; POSE_ERR_UNSUPPORTED for POSE_COR on a rig without CoR. @since 0.1 */
+POSE_API pose_status pose_set_method(pose_state *state, pose_method method);
+/** The current skinning method. @since 0.1 */
+POSE_API pose_method pose_get_method(const pose_state *state);
+/** Number of worker threads for pose_apply (0 = cores). Results are identical for
+ *  any thread count. @since 0.1 */
+POSE_API pose_status pose_set_threads(pose_state *state, int threads);
+
+/**
+ * Pose the anatomy: forward kinematics, skinning of the tet mesh, transfer to
+ * every tissue vertex, normals. Allocates nothing. @since 0.1
+ */
+POSE_API pose_status pose_apply(pose_state *state);
+
+/**
+ * Deformed positions of tissue `tissue` after the last pose_apply (rest
+ * positions before the first). Owned by the state, valid until it is freed;
+ * overwritten by pose_apply. NULL if the index is out of range.
+ * @since 0.1
+ */
+POSE_API const float *pose_tissue_positions(const pose_state *state, int tissue, size_t *vertex_count);
+/** Unit vertex normals of tissue `tissue`, as pose_tissue_positions. @since 0.1 */
+POSE_API const float *pose_tissue_normals(const pose_state *state, int tissue, size_t *vertex_count);
+/** Deformed tet mesh vertices, as pose_tissue_positions. @since 0.1 */
+POSE_API const float *pose_tet_positions(const pose_state *state, size_t *vertex_count);
+/** Joint frame in model space after the last pose_apply. @since 0.1 */
+POSE_API pose_status pose_joint_world(const pose_state *state, int joint, pose_transform *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* POSE_POSE_H */
