@@ -5,6 +5,14 @@
  * One backend per file (hid_hidraw.c, can_socketcan.c, mocap_bvh.c,
  * replay_*.c), each filling a pb_source_ops table. Simulated devices are
  * sources that replay recordings through the same decoder as the live path.
+ *
+ * Lifetime: a backend's open function allocates its whole struct (which
+ * embeds pb_source first) with malloc/calloc and hands out the pb_source
+ * pointer; pb_source_destroy() calls ops->close and then frees it.
+ * Threads: a source is used by one thread at a time (the bridge thread).
+ * The mapping layer (mapping.h) turns channel values into joint targets:
+ * it binds mapping entries to channels by name (pb_channel.name) or by
+ * HID usage (pb_channel.usage), so name channels stably.
  */
 #ifndef POSE_BRIDGE_SOURCE_H
 #define POSE_BRIDGE_SOURCE_H
@@ -74,5 +82,18 @@ void pb_source_set_state(pb_source *src, pb_source_state state, const char *fmt,
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
+
+/** Lower-case name of a state ("ok", "stale" ...); static storage. */
+const char *pb_source_state_name(pb_source_state state);
+/** ops->read with argument checks: 1 update, 0 timeout, -1 error. */
+int pb_source_read(pb_source *src, pb_update *out, int timeout_ms);
+/** ops->seek, or -1 when the source cannot seek. */
+int pb_source_seek(pb_source *src, int64_t t_ns);
+/** ops->close only (the struct stays allocated). NULL is a no-op. */
+void pb_source_close(pb_source *src);
+/** ops->close, then free(src). NULL is a no-op. */
+void pb_source_destroy(pb_source *src);
+/** Index of the channel with this exact name, or -1. */
+long pb_source_find_channel(const pb_source *src, const char *name);
 
 #endif /* POSE_BRIDGE_SOURCE_H */
