@@ -35,11 +35,15 @@ typedef struct pp_tetmesh {
     uint16_t *labels;      /**< tet_count */
 } pp_tetmesh;
 
-/** Quality figures of a tet mesh. */
+/** Quality figures of a tet mesh (see tet_quality.h). */
 typedef struct pp_tet_quality {
     double min_dihedral_deg, max_dihedral_deg;
-    double max_radius_edge;
-    double min_volume;
+    double max_radius_edge;    /**< circumradius / shortest edge; 0.612 for a regular tet */
+    double min_volume;         /**< m^3, signed: negative when a tet is inverted */
+    double total_volume;       /**< m^3, sum of signed volumes */
+    size_t inverted_count;     /**< tets with volume <= 0 */
+    size_t vertex_count, tet_count;
+    double seconds;            /**< wall time of the stage that built the mesh */
 } pp_tet_quality;
 
 void pp_mesh_free(pp_mesh *m);

@@ -1,0 +1,77 @@
+/* SPDX-License-Identifier: Apache-2.0
+ *
+ * Tetrahedralize the labelled body. Two backends behind one call:
+ *
+ *  - PP_TET_LATTICE (built in, Apache-2.0, the default): a Kuhn
+ *    (Freudenthal) lattice of the voxel image: every body cell is split into
+ *    six congruent tets along its main diagonal, which conforms across cells
+ *    without any search, then the outer boundary vertices are snapped onto
+ *    the skin surface (each move is backed off until no incident tet loses
+ *    more than 90 % of its volume, so nothing inverts). Tet labels are the
+ *    cells' voxel labels. The size budget picks the cell size.
+ *  - PP_TET_TETGEN (only when built with POSE_WITH_TETGEN; AGPL-3+): TetGen
+ *    meshes the skin surface as a PLC with quality switches ("pq<ratio>a<vol>")
+ *    and the centres of bone boundary voxels as inserted points, so the mesh
+ *    resolves bones; each tet takes the voxel label at its centroid.
+ *
+ * Labels in pp_tetmesh: 0 soft tissue, j + 1 bone of joint j (voxel label
+ * 2 + j). All tets are positively oriented: det[b-a, c-a, d-a] > 0.
+ */
+#ifndef POSE_PP_TETMESH_H
+#define POSE_PP_TETMESH_H
+
+#include "pp_types.h"
+
+#include <pose/pose.h>
+
+typedef enum pp_tet_backend {
+    PP_TET_DEFAULT = 0, /**< the built-in lattice */
+    PP_TET_LATTICE = 1,
+    PP_TET_TETGEN = 2
+} pp_tet_backend;
+
+/** Options; zero means default for every field. */
+typedef struct pp_tet_options {
+    pp_tet_backend backend;
+    size_t target_vertices;  /**< size budget; 0: lattice = voxel grid, TetGen = its own sizing */
+    double max_radius_edge;  /**< TetGen -q bound (default 1.414) */
+    int no_snap;             /**< lattice: keep the staircase boundary (for tests) */
+    int verbose;             /**< TetGen: print its own log to stdout */
+} pp_tet_options;
+
+/** Name ("lattice", "tetgen") and parse; parse returns -1 for an unknown name. */
+const char *pp_tet_backend_name(pp_tet_backend b);
+int pp_tet_backend_parse(const char *name, pp_tet_backend *out);
+
+/** 1 when the backend is compiled in (TetGen needs POSE_WITH_TETGEN). */
+int pp_tet_backend_available(pp_tet_backend b);
+
+/**
+ * Build the labelled tet mesh of the body.
+ * @param vox   labelled image from pp_voxelize
+ * @param skin  the skin surface (lattice: snapping target; TetGen: the PLC);
+ *              may be NULL for the lattice (no snapping)
+ * @param opt   options (NULL for defaults)
+ * @param out   the mesh; free with pp_tetmesh_free()
+ * @param q     optional: quality figures of the result (tet_quality.h)
+ * @return POSE_OK; POSE_ERR_UNSUPPORTED for TetGen in a build without it;
+ *         POSE_ERR_INVALID_DATA when the image has no body voxel or TetGen
+ *         rejects the surface (message says why); POSE_ERR_OUT_OF_MEMORY.
+ */
+pose_status pp_tetrahedralize(const pp_voxels *vox, const pp_mesh *skin,
+                              const pp_tet_options *opt, pp_tetmesh *out, pp_tet_quality *q,
+                              char *err, size_t errlen);
+
+/* Backends (called by pp_tetrahedralize; same contract). */
+pose_status pp_tet_lattice(const pp_voxels *vox, const pp_mesh *skin, const pp_tet_options *opt,
+                           pp_tetmesh *out, char *err, size_t errlen);
+pose_status pp_tet_tetgen(const pp_voxels *vox, const pp_mesh *skin, const pp_tet_options *opt,
+                          pp_tetmesh *out, char *err, size_t errlen);
+
+/** Quality figures of any tet mesh (seconds left 0). */
+void pp_tet_quality_measure(const pp_tetmesh *t, pp_tet_quality *q);
+
+/** Signed volume of tet i (positive when positively oriented). */
+double pp_tet_volume(const pp_tetmesh *t, size_t i);
+
+#endif /* POSE_PP_TETMESH_H */
