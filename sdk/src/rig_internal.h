@@ -1,0 +1,107 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The in-memory rig. Every array is read-only and lives either in one block
+ * the rig owns (pose_rig_create, pose_rig_load_ex with POSE_LOAD_NO_MMAP,
+ * pose_rig_load_memory without POSE_LOAD_BORROW), in a read-only mapping of
+ * the rig file (pose_rig_load), or in a caller's buffer (POSE_LOAD_BORROW).
+ * Arrays that come from the file point straight into it; only data derived at
+ * load time (rest_local, the tissue table) is allocated separately. */
+#ifndef POSE_RIG_INTERNAL_H
+#define POSE_RIG_INTERNAL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "pose/pose.h"
+
+/** Names are stored in fixed 64-byte slots, NUL-terminated (1..63 bytes). */
+#define POSE__NAME_SIZE 64
+/** Most weights a tet vertex may carry. */
+#define POSE__MAX_INFLUENCES 8
+/** Joints are indexed by uint16 in weights and by label - 1 in tet labels. */
+#define POSE__MAX_JOINTS 65534u
+
+/** A joint's limits, as stored in the file (32 bytes, little-endian). */
+typedef struct pose__joint_limit {
+    uint32_t flags;       /* POSE_LIMIT_* */
+    uint32_t order;       /* pose_euler_order */
+    float min_deg[3];
+    float max_deg[3];
+} pose__joint_limit;
+
+/** One tissue surface; arrays point into the rig's storage. */
+typedef struct pose__tissue {
+    const char *name;         /* NUL-terminated, < POSE__NAME_SIZE bytes */
+    pose_tissue_kind kind;
+    int32_t joint;            /* -1 unless a bone of that joint */
+    size_t vertex_count;
+    size_t triangle_count;
+    const float *positions;   /* 3 * vertex_count rest positions */
+    const uint32_t *triangles;/* 3 * triangle_count vertex indices */
+    const uint32_t *tet;      /* vertex_count embedding tet indices */
+    const float *bary;        /* 4 * vertex_count barycentric coordinates */
+} pose__tissue;
+
+/** Where the rig's bytes came from, so pose_rig_free releases the right thing. */
+typedef enum pose__rig_storage {
+    POSE__STORAGE_OWNED = 0,  /* `block` allocated with `allocator` */
+    POSE__STORAGE_MAPPED = 1, /* `block` is an mmap of `block_size` bytes */
+    POSE__STORAGE_BORROWED = 2/* `block` belongs to the caller */
+} pose__rig_storage;
+
+struct pose__rig_runtime; /* owned by the runtime (rig_prepare.c) */
+
+struct pose_rig {
+    /* ---- skeleton: structure of arrays, parents before children */
+    size_t joint_count;
+    const char *joint_names;               /* joint_count * POSE__NAME_SIZE bytes */
+    const int32_t *joint_parents;          /* -1 for roots, else < own index */
+    const pose_transform *joint_rest_model;/* joint frame at rest, model space */
+    const pose_transform *joint_rest_local;/* relative to parent (= rest_model for roots) */
+    const pose__joint_limit *joint_limits;
+
+    /* ---- tet mesh */
+    size_t tet_vertex_count;
+    const float *tet_positions;            /* 3 * tet_vertex_count */
+    size_t tet_count;
+    const uint32_t *tets;                  /* 4 * tet_count */
+    const uint16_t *tet_labels;            /* 0 soft tissue, j + 1 bone of joint j */
+
+    /* ---- skinning weights (K per tet vertex, >= 0, summing to 1) */
+    unsigned influences;                   /* K, 1..POSE__MAX_INFLUENCES */
+    const uint16_t *weight_joints;         /* K * tet_vertex_count */
+    const float *weights;                  /* K * tet_vertex_count */
+    const float *cor;                      /* 3 * tet_vertex_count, or NULL */
+
+    /* ---- tissues */
+    size_t tissue_count;
+    const pose__tissue *tissues;           /* allocated table, arrays point into storage */
+
+    const char *metadata;                  /* NUL-terminated, "" when none */
+
+    /* ---- ownership */
+    pose_allocator allocator;              /* always filled (defaults resolved) */
+    pose__rig_storage storage;
+    void *block;                           /* file bytes / serialized description */
+    size_t block_size;
+    void *derived;                         /* one allocation: rest_local + tissue table */
+
+    /* ---- runtime-derived data (compact weights, ...); opaque here */
+    struct pose__rig_runtime *rt;
+};
+
+/** Name of joint `j` (NUL-terminated). */
+static inline const char *pose__joint_name(const pose_rig *rig, size_t j)
+{
+    return rig->joint_names + j * POSE__NAME_SIZE;
+}
+
+/**
+ * Build runtime-derived data (rig->rt). Called once at the end of every
+ * successful create/load, after full validation. On failure the rig is freed
+ * by the caller; pose__set_error has been called.
+ */
+pose_status pose__rig_prepare(pose_rig *rig);
+/** Release what pose__rig_prepare built; tolerates rig->rt == NULL. */
+void pose__rig_release(pose_rig *rig);
+
+#endif /* POSE_RIG_INTERNAL_H */
