@@ -1,0 +1,125 @@
+/* SPDX-License-Identifier: Apache-2.0
+ * Small double-precision vector and quaternion helpers for the bridge.
+ * Quaternions are {x, y, z, w} like the public API; vectors are double[3].
+ * Euler orders follow pose.h: POSE_EULER_ZXY means R = Rz * Rx * Ry
+ * (intrinsic, the BVH channel-list convention). */
+#ifndef POSE_BRIDGE_MATH_H
+#define POSE_BRIDGE_MATH_H
+
+#include <math.h>
+
+#include "pose/pose.h"
+
+#define PB_DEG2RAD 0.017453292519943295
+#define PB_RAD2DEG 57.29577951308232
+
+static inline void pb_quat_identity(double q[4]) { q[0] = q[1] = q[2] = 0.0; q[3] = 1.0; }
+
+static inline void pb_quat_copy(double d[4], const double s[4])
+{
+    d[0] = s[0]; d[1] = s[1]; d[2] = s[2]; d[3] = s[3];
+}
+
+/** out = a * b (apply b first, then a); out may alias a or b. */
+static inline void pb_quat_mul(const double a[4], const double b[4], double out[4])
+{
+    double x = a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1];
+    double y = a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0];
+    double z = a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3];
+    double w = a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2];
+    out[0] = x; out[1] = y; out[2] = z; out[3] = w;
+}
+
+static inline void pb_quat_conj(const double q[4], double out[4])
+{
+    out[0] = -q[0]; out[1] = -q[1]; out[2] = -q[2]; out[3] = q[3];
+}
+
+static inline void pb_quat_normalize(double q[4])
+{
+    double n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (n > 0.0) {
+        q[0] /= n; q[1] /= n; q[2] /= n; q[3] /= n;
+    } else {
+        pb_quat_identity(q);
+    }
+}
+
+/** out = q v q^-1 for a unit q; out may alias v. */
+static inline void pb_quat_rotate(const double q[4], const double v[3], double out[3])
+{
+    /* t = 2 q.xyz x v; v' = v + w t + q.xyz x t */
+    double tx = 2.0 * (q[1] * v[2] - q[2] * v[1]);
+    double ty = 2.0 * (q[2] * v[0] - q[0] * v[2]);
+    double tz = 2.0 * (q[0] * v[1] - q[1] * v[0]);
+    double x = v[0] + q[3] * tx + (q[1] * tz - q[2] * ty);
+    double y = v[1] + q[3] * ty + (q[2] * tx - q[0] * tz);
+    double z = v[2] + q[3] * tz + (q[0] * ty - q[1] * tx);
+    out[0] = x; out[1] = y; out[2] = z;
+}
+
+/** Rotation of `deg` degrees about axis 0 (x), 1 (y) or 2 (z). */
+static inline void pb_quat_axis_deg(int axis, double deg, double q[4])
+{
+    double h = 0.5 * deg * PB_DEG2RAD;
+    q[0] = q[1] = q[2] = 0.0;
+    q[axis] = sin(h);
+    q[3] = cos(h);
+}
+
+/** Axis order of a pose_euler_order, outermost first: ZXY -> {2, 0, 1}. */
+static inline void pb_euler_axes(pose_euler_order order, int axes[3])
+{
+    static const int table[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    int o = (int)order >= 0 && (int)order < 6 ? (int)order : 0;
+    axes[0] = table[o][0]; axes[1] = table[o][1]; axes[2] = table[o][2];
+}
+
+/** Quaternion of Euler angles deg = {x, y, z} composed in `order`. */
+static inline void pb_quat_from_euler(const double deg[3], pose_euler_order order, double q[4])
+{
+    int ax[3];
+    pb_euler_axes(order, ax);
+    double r[4];
+    pb_quat_identity(q);
+    for (int i = 0; i < 3; i++) {
+        pb_quat_axis_deg(ax[i], deg[ax[i]], r);
+        pb_quat_mul(q, r, q);
+    }
+}
+
+void pb_quat_to_euler(const double q[4], pose_euler_order order, double deg[3]);
+
+static inline double pb_quat_dot(const double a[4], const double b[4])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
+}
+
+/** Shortest-path spherical interpolation, t in [0, 1]. */
+static inline void pb_quat_slerp(const double a[4], const double b[4], double t, double out[4])
+{
+    double d = pb_quat_dot(a, b), s = 1.0;
+    if (d < 0.0) {
+        d = -d;
+        s = -1.0;
+    }
+    double wa, wb;
+    if (d > 0.9995) { /* nearly parallel: lerp is exact enough and avoids 0/0 */
+        wa = 1.0 - t;
+        wb = t;
+    } else {
+        double th = acos(d), sn = sin(th);
+        wa = sin((1.0 - t) * th) / sn;
+        wb = sin(t * th) / sn;
+    }
+    for (int i = 0; i < 4; i++)
+        out[i] = wa * a[i] + s * wb * b[i];
+    pb_quat_normalize(out);
+}
+
+/** Smallest rotation taking direction u to direction v (need not be unit). */
+void pb_quat_from_to(const double u[3], const double v[3], double q[4]);
+
+static inline double pb_vec_len(const double v[3]) { return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+
+#endif /* POSE_BRIDGE_MATH_H */

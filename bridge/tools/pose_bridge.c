@@ -1,0 +1,63 @@
+/* SPDX-License-Identifier: Apache-2.0
+ * pose-bridge: command-line front end of the input bridge.
+ *
+ * Adding a subcommand: create bridge/tools/cmd_<name>.c that defines
+ *     const pb_command pb_cmd_<name> = {"cli-name", "summary", run_fn};
+ * (see pose_bridge_cli.h) and re-run cmake. bridge/CMakeLists.txt globs
+ * tools/cmd_*.c and generates the table pb_commands[] from the file names,
+ * so no central list needs editing. <name> must be a C identifier
+ * (cmd_hid_describe.c -> pb_cmd_hid_describe, typed as "hid-describe").
+ * Each subcommand parses its own options, answers --help, prints results on
+ * stdout (JSON with --json) and errors on stderr, and returns 0 on success.
+ */
+#include <string.h>
+
+#include "pose_bridge_cli.h"
+
+int pb_cli_wants_help(int argc, char **argv)
+{
+    for (int i = 1; i < argc; i++)
+        if (strcmp(argv[i], "-h") == 0 || strcmp(argv[i], "--help") == 0)
+            return 1;
+    return 0;
+}
+
+void pb_cli_json_string(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; s && *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            fprintf(f, "\\%c", c);
+        else if (c < 0x20)
+            fprintf(f, "\\u%04x", c);
+        else
+            fputc(c, f);
+    }
+    fputc('"', f);
+}
+
+static void usage(FILE *f)
+{
+    fprintf(f, "usage: pose-bridge <command> [options]   (pose-bridge <command> --help)\n\ncommands:\n");
+    for (const pb_command *const *c = pb_commands; *c; c++)
+        fprintf(f, "  %-16s %s\n", (*c)->name, (*c)->summary);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return 2;
+    }
+    if (strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "help") == 0) {
+        usage(stdout);
+        return 0;
+    }
+    for (const pb_command *const *c = pb_commands; *c; c++)
+        if (strcmp((*c)->name, argv[1]) == 0)
+            return (*c)->run(argc - 1, argv + 1);
+    fprintf(stderr, "pose-bridge: unknown command '%s'\n", argv[1]);
+    usage(stderr);
+    return 2;
+}
