@@ -1,14 +1,190 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Runtime-derived rig data. Stub: the runtime replaces this file. */
+/* Runtime-derived rig data (see rig_runtime.h), built once per rig. */
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "alloc.h"
+#include "error.h"
 #include "rig_internal.h"
+#include "rig_runtime.h"
+
+static size_t align64(size_t n)
+{
+    return (n + 63u) & ~(size_t)63u;
+}
+
+/* Quantize one vertex's K weights to 15-bit fixed point summing to exactly
+ * POSE__WEIGHT_ONE, largest first (DQS/CoR align signs to the first joint). */
+static void compact_weights(unsigned K, const uint16_t *joints, const float *weights,
+                            uint16_t *out_joints, uint16_t *out_weights)
+{
+    unsigned order[POSE__MAX_INFLUENCES];
+    for (unsigned k = 0; k < K; k++)
+        order[k] = k;
+    for (unsigned a = 1; a < K; a++) { /* insertion sort, stable, K <= 8 */
+        unsigned v = order[a], b = a;
+        while (b > 0 && weights[order[b - 1]] < weights[v]) {
+            order[b] = order[b - 1];
+            b--;
+        }
+        order[b] = v;
+    }
+    double sum = 0.0;
+    for (unsigned k = 0; k < K; k++)
+        sum += weights[k];
+    long total = 0;
+    for (unsigned k = 0; k < K; k++) {
+        unsigned src = order[k];
+        long q = lround((double)weights[src] / sum * POSE__WEIGHT_ONE);
+        out_joints[k] = joints[src];
+        out_weights[k] = (uint16_t)q;
+        total += q;
+    }
+    /* Rounding leaves at most K/2 units over or under: give them to the
+     * largest weight, which is at least POSE__WEIGHT_ONE / K. */
+    out_weights[0] = (uint16_t)((long)out_weights[0] + ((long)POSE__WEIGHT_ONE - total));
+}
+
+/* Area-weighted unit vertex normals of one tissue from its rest triangles. */
+static void rest_normals(const pose__tissue *t, float *out)
+{
+    memset(out, 0, 3 * t->vertex_count * sizeof(float));
+    const float *p = t->positions;
+    for (size_t f = 0; f < t->triangle_count; f++) {
+        const uint32_t *tri = t->triangles + 3 * f;
+        const float *a = p + 3 * (size_t)tri[0], *b = p + 3 * (size_t)tri[1],
+                    *c = p + 3 * (size_t)tri[2];
+        float u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        float v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        float n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                      u[0] * v[1] - u[1] * v[0]};
+        for (int k = 0; k < 3; k++)
+            for (int d = 0; d < 3; d++)
+                out[3 * (size_t)tri[k] + d] += n[d];
+    }
+    for (size_t i = 0; i < t->vertex_count; i++) {
+        float *n = out + 3 * i;
+        double l = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+        float s = l > 0.0 ? (float)(1.0 / l) : 0.0f;
+        n[0] *= s; n[1] *= s; n[2] *= s;
+    }
+}
+
+/* One tissue vertex: tet vertices with the largest coordinate first,
+ * b1..b3, and the normal key sign(det D) D^T n (see rt_transfer.h). */
+static void embed_vertex(const pose_rig *rig, const uint32_t *tet, const float *b4,
+                         const float *normal, uint32_t *tv, float *b3, int16_t *key)
+{
+    unsigned first = 0;
+    for (unsigned k = 1; k < 4; k++)
+        if (b4[k] > b4[first])
+            first = k;
+    unsigned perm[4] = {first, 0, 0, 0};
+    for (unsigned k = 0, n = 1; k < 4; k++)
+        if (k != first)
+            perm[n++] = k;
+    for (unsigned k = 0; k < 4; k++)
+        tv[k] = tet[perm[k]];
+    for (unsigned k = 0; k < 3; k++)
+        b3[k] = b4[perm[k + 1]];
+
+    const float *v0 = rig->tet_positions + 3 * (size_t)tv[0];
+    double e[3][3], m[3];
+    for (int k = 0; k < 3; k++) {
+        const float *vk = rig->tet_positions + 3 * (size_t)tv[k + 1];
+        for (int d = 0; d < 3; d++)
+            e[k][d] = (double)vk[d] - v0[d];
+        m[k] = e[k][0] * normal[0] + e[k][1] * normal[1] + e[k][2] * normal[2];
+    }
+    double det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+                 e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                 e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+    double big = fmax(fabs(m[0]), fmax(fabs(m[1]), fabs(m[2])));
+    for (int k = 0; k < 3; k++)
+        key[k] = (big > 0.0 && det != 0.0)
+                     ? (int16_t)lround((det < 0.0 ? -m[k] : m[k]) / big * 32767.0)
+                     : 0;
+}
 
 pose_status pose__rig_prepare(pose_rig *rig)
 {
     rig->rt = NULL;
+    const size_t nv = rig->tet_vertex_count, K = rig->influences, nj = rig->joint_count;
+    size_t total = 0;
+    for (size_t t = 0; t < rig->tissue_count; t++)
+        total += rig->tissues[t].vertex_count;
+    const int narrow = nj <= 256;
+
+    /* One block: header, joints, weights, tissue arrays, rest frames. */
+    size_t off_rt = 0;
+    size_t off_joints = align64(sizeof(struct pose__rig_runtime));
+    size_t off_weights = off_joints + align64(nv * K * (narrow ? 1 : 2));
+    size_t off_offsets = off_weights + align64(nv * K * 2);
+    size_t off_tv = off_offsets + align64((rig->tissue_count + 1) * sizeof(size_t));
+    size_t off_bary = off_tv + align64(total * 4 * sizeof(uint32_t));
+    size_t off_key = off_bary + align64(total * 3 * sizeof(float));
+    size_t off_normals = off_key + align64(total * 3 * sizeof(int16_t));
+    size_t off_rest = off_normals + align64(total * 3 * sizeof(float));
+    size_t size = off_rest + align64(nj * sizeof(pose__xform));
+    unsigned char *block = pose__calloc(&rig->allocator, size, POSE__ALIGN);
+    if (!block)
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY,
+                          "out of memory preparing the rig for the runtime (%zu bytes)", size);
+    struct pose__rig_runtime *rt = (struct pose__rig_runtime *)(block + off_rt);
+    rt->block = block;
+
+    uint16_t *w16 = (uint16_t *)(block + off_weights);
+    uint8_t *j8 = narrow ? block + off_joints : NULL;
+    uint16_t *j16 = narrow ? NULL : (uint16_t *)(block + off_joints);
+    for (size_t i = 0; i < nv; i++) {
+        uint16_t joints[POSE__MAX_INFLUENCES];
+        uint16_t *dst = narrow ? joints : j16 + i * K;
+        compact_weights((unsigned)K, rig->weight_joints + i * K, rig->weights + i * K, dst,
+                        w16 + i * K);
+        if (narrow)
+            for (size_t k = 0; k < K; k++)
+                j8[i * K + k] = (uint8_t)joints[k];
+    }
+    rt->skin = (pose__skin_mesh){
+        .vertex_count = nv, .influences = (unsigned)K, .rest = rig->tet_positions,
+        .cor = rig->cor, .joints8 = j8, .joints16 = j16, .weights = w16,
+    };
+
+    rt->tissue_offset = (size_t *)(block + off_offsets);
+    rt->rest_normals = (float *)(block + off_normals);
+    uint32_t *tv = (uint32_t *)(block + off_tv);
+    float *bary = (float *)(block + off_bary);
+    int16_t *key = (int16_t *)(block + off_key);
+    size_t base = 0;
+    for (size_t t = 0; t < rig->tissue_count; t++) {
+        const pose__tissue *ts = &rig->tissues[t];
+        rt->tissue_offset[t] = base;
+        rest_normals(ts, rt->rest_normals + 3 * base);
+        for (size_t v = 0; v < ts->vertex_count; v++) {
+            size_t g = base + v;
+            embed_vertex(rig, rig->tets + 4 * (size_t)ts->tet[v], ts->bary + 4 * v,
+                         rt->rest_normals + 3 * g, tv + 4 * g, bary + 3 * g, key + 3 * g);
+        }
+        base += ts->vertex_count;
+    }
+    rt->tissue_offset[rig->tissue_count] = base;
+    rt->transfer = (pose__transfer_mesh){
+        .vertex_count = total, .tet_vertices = tv, .bary = bary, .normal_key = key,
+    };
+
+    rt->rest_model = (pose__xform *)(block + off_rest);
+    for (size_t j = 0; j < nj; j++) {
+        memcpy(rt->rest_model[j].q, rig->joint_rest_model[j].rotation, sizeof(float) * 4);
+        memcpy(rt->rest_model[j].t, rig->joint_rest_model[j].translation, sizeof(float) * 3);
+    }
+    rig->rt = rt;
     return POSE_OK;
 }
 
 void pose__rig_release(pose_rig *rig)
 {
+    if (rig->rt)
+        pose__free(&rig->allocator, rig->rt->block);
     rig->rt = NULL;
 }

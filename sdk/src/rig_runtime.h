@@ -1,0 +1,29 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* Data derived from a rig at load time for the runtime kernels
+ * (built by pose__rig_prepare, read by every pose_state of the rig). */
+#ifndef POSE_RIG_RUNTIME_H
+#define POSE_RIG_RUNTIME_H
+
+#include <stddef.h>
+
+#include "rt_quat.h"
+#include "rt_skin.h"
+#include "rt_transfer.h"
+
+struct pose__rig_runtime {
+    /** Tet vertices: the rig's rest positions and centres, compact weights
+     *  (8-bit joints when the rig has <= 256 joints, 15-bit fixed-point
+     *  weights, largest first, summing exactly to one). */
+    pose__skin_mesh skin;
+    /** All tissues' vertices, one after another (tissue t starts at
+     *  tissue_offset[t]), in the rig's order: outputs are written in the
+     *  order the API returns them, and the deformed tet vertices they read
+     *  (12 bytes each, 9.6 MB for 800 k) stay in the last-level cache. */
+    pose__transfer_mesh transfer;
+    size_t *tissue_offset;   /**< tissue_count + 1 */
+    float *rest_normals;     /**< 3 * total tissue vertices, area-weighted, unit (0 if none) */
+    pose__xform *rest_model; /**< joint frames at rest, as runtime transforms */
+    void *block;             /**< the one allocation holding all of the above */
+};
+
+#endif /* POSE_RIG_RUNTIME_H */

@@ -1,0 +1,263 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* pose_state: creation, threads, method, pose_apply and its outputs. */
+#include <string.h>
+#include <unistd.h>
+
+#include "alloc.h"
+#include "error.h"
+#include "rt_fk.h"
+#include "rt_transfer.h"
+#include "state_internal.h"
+
+/* More threads than this cannot help a memory-bound kernel. */
+#define POSE__MAX_THREADS 256
+
+static size_t align64(size_t n)
+{
+    return (n + 63u) & ~(size_t)63u;
+}
+
+static unsigned resolve_threads(int threads)
+{
+    if (threads > 0)
+        return threads > POSE__MAX_THREADS ? POSE__MAX_THREADS : (unsigned)threads;
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    if (n < 1)
+        n = 1;
+    return n > POSE__MAX_THREADS ? POSE__MAX_THREADS : (unsigned)n;
+}
+
+static pose_status start_pool(pose_state *st, unsigned threads)
+{
+    pose__pool *pool = pose__alloc(&st->allocator, pose__pool_size(threads), POSE__ALIGN);
+    if (!pool)
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for a pool of %u threads",
+                          threads);
+    if (pose__pool_init(pool, threads) != 0) {
+        pose__free(&st->allocator, pool);
+        return pose__fail(POSE_ERR_THREAD, "could not start %u worker threads", threads - 1);
+    }
+    if (st->pool) {
+        pose__pool_destroy(st->pool);
+        pose__free(&st->allocator, st->pool);
+    }
+    st->pool = pool;
+    return POSE_OK;
+}
+
+static pose_status check_method(const pose_rig *rig, pose_method method)
+{
+    if ((int)method < POSE_LBS || (int)method > POSE_COR)
+        return pose__fail(POSE_ERR_INVALID_ARGUMENT, "unknown skinning method %d", (int)method);
+    if (method == POSE_COR && !rig->cor)
+        return pose__fail(POSE_ERR_UNSUPPORTED,
+                          "POSE_COR needs centres of rotation, and this rig has none");
+    return POSE_OK;
+}
+
+static void set_rest_outputs(pose_state *st)
+{
+    const pose_rig *rig = st->rig;
+    const struct pose__rig_runtime *rt = st->rt;
+    memcpy(st->tet_positions, rig->tet_positions, 3 * rig->tet_vertex_count * sizeof(float));
+    for (size_t t = 0; t < rig->tissue_count; t++)
+        memcpy(st->tissue_positions + 3 * rt->tissue_offset[t], rig->tissues[t].positions,
+               3 * rig->tissues[t].vertex_count * sizeof(float));
+    memcpy(st->tissue_normals, rt->rest_normals,
+           3 * rt->transfer.vertex_count * sizeof(float));
+    for (size_t j = 0; j < rig->joint_count; j++) {
+        pose__xform_identity(&st->skin[j]);
+        st->world[j] = rt->rest_model[j];
+    }
+}
+
+pose_status pose_state_create(const pose_rig *rig, pose_state **out)
+{
+    return pose_state_create_ex(rig, NULL, out);
+}
+
+pose_status pose_state_create_ex(const pose_rig *rig, const pose_state_options *options,
+                                 pose_state **out)
+{
+    pose__clear_error();
+    if (out)
+        *out = NULL;
+    if (!rig || !out)
+        return pose__fail(POSE_ERR_INVALID_ARGUMENT, "pose_state_create: rig and out are required");
+    if (!rig->rt)
+        return pose__fail(POSE_ERR_INVALID_ARGUMENT, "pose_state_create: rig is not prepared");
+    pose_state_options opt = {0};
+    if (options)
+        opt = *options;
+    if (!pose__allocator_valid(&opt.allocator))
+        return pose__fail(POSE_ERR_INVALID_ARGUMENT,
+                          "pose_state_create: allocator needs both alloc and free");
+    if (opt.threads < 0)
+        return pose__fail(POSE_ERR_INVALID_ARGUMENT, "pose_state_create: threads = %d",
+                          opt.threads);
+    pose_status st_method = check_method(rig, opt.method);
+    if (st_method < 0)
+        return st_method;
+
+    const size_t nj = rig->joint_count, nv = rig->tet_vertex_count;
+    const size_t nt = rig->rt->transfer.vertex_count;
+    size_t off_local = align64(sizeof(pose_state));
+    size_t off_skin = off_local + align64(nj * sizeof(float[4]));
+    size_t off_world = off_skin + align64(nj * sizeof(pose__xform));
+    size_t off_palette = off_world + align64(nj * sizeof(pose__xform));
+    size_t off_tet = off_palette + align64(nj * sizeof(pose__skin_joint));
+    size_t off_pos = off_tet + align64(3 * nv * sizeof(float));
+    size_t off_nrm = off_pos + align64(3 * nt * sizeof(float));
+    size_t size = off_nrm + align64(3 * nt * sizeof(float));
+
+    pose_allocator alloc = pose__allocator_resolve(&opt.allocator);
+    unsigned char *block = pose__alloc(&alloc, size, POSE__ALIGN);
+    if (!block)
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for a pose state (%zu bytes)",
+                          size);
+    pose_state *st = (pose_state *)block;
+    memset(st, 0, sizeof *st);
+    st->rig = rig;
+    st->rt = rig->rt;
+    st->allocator = alloc;
+    st->method = opt.method;
+    st->block = block;
+    st->local = (float(*)[4])(block + off_local);
+    st->skin = (pose__xform *)(block + off_skin);
+    st->world = (pose__xform *)(block + off_world);
+    st->palette = (pose__skin_joint *)(block + off_palette);
+    st->tet_positions = (float *)(block + off_tet);
+    st->tissue_positions = (float *)(block + off_pos);
+    st->tissue_normals = (float *)(block + off_nrm);
+    for (size_t j = 0; j < nj; j++)
+        pose__quat_identity(st->local[j]);
+    pose__xform_identity(&st->root);
+    set_rest_outputs(st);
+
+    pose_status s = start_pool(st, resolve_threads(opt.threads));
+    if (s < 0) {
+        pose__free(&alloc, block);
+        return s;
+    }
+    *out = st;
+    return POSE_OK;
+}
+
+void pose_state_free(pose_state *st)
+{
+    if (!st)
+        return;
+    pose_allocator alloc = st->allocator;
+    if (st->pool) {
+        pose__pool_destroy(st->pool);
+        pose__free(&alloc, st->pool);
+    }
+    pose__free(&alloc, st->block);
+}
+
+const pose_rig *pose_state_rig(const pose_state *st)
+{
+    return st ? st->rig : NULL;
+}
+
+pose_status pose_set_method(pose_state *st, pose_method method)
+{
+    pose__clear_error();
+    if (!st)
+        return pose__fail(POSE_ERR_INVALID_ARGUMENT, "pose_set_method: state is NULL");
+    pose_status s = check_method(st->rig, method);
+    if (s < 0)
+        return s;
+    st->method = method;
+    return POSE_OK;
+}
+
+pose_method pose_get_method(const pose_state *st)
+{
+    return st ? st->method : POSE_LBS;
+}
+
+pose_status pose_set_threads(pose_state *st, int threads)
+{
+    pose__clear_error();
+    if (!st || threads < 0)
+        return pose__fail(POSE_ERR_INVALID_ARGUMENT, "pose_set_threads: %s",
+                          st ? "threads must be >= 0" : "state is NULL");
+    unsigned n = resolve_threads(threads);
+    if (n == pose__pool_threads(st->pool))
+        return POSE_OK;
+    return start_pool(st, n);
+}
+
+/* The two parallel passes of pose_apply. Ranges are split by part only:
+ * every vertex is computed on its own, so results do not depend on the
+ * thread count. */
+static void skin_task(void *ctx, unsigned part, unsigned parts)
+{
+    pose_state *st = ctx;
+    const pose__skin_mesh *mesh = &st->rt->skin;
+    size_t b = pose__part_begin(mesh->vertex_count, part, parts);
+    size_t e = pose__part_begin(mesh->vertex_count, part + 1, parts);
+    pose__skin((int)st->method, mesh, st->palette, b, e, st->tet_positions);
+}
+
+static void transfer_task(void *ctx, unsigned part, unsigned parts)
+{
+    pose_state *st = ctx;
+    const pose__transfer_mesh *mesh = &st->rt->transfer;
+    size_t b = pose__part_begin(mesh->vertex_count, part, parts);
+    size_t e = pose__part_begin(mesh->vertex_count, part + 1, parts);
+    pose__transfer(mesh, st->tet_positions, b, e, st->tissue_positions, st->tissue_normals);
+}
+
+pose_status pose_apply(pose_state *st)
+{
+    pose__clear_error();
+    if (!st)
+        return pose__fail(POSE_ERR_INVALID_ARGUMENT, "pose_apply: state is NULL");
+    const pose_rig *rig = st->rig;
+    pose__fk(rig->joint_count, rig->joint_parents, st->rt->rest_model,
+             (const float(*)[4])st->local, &st->root, st->skin, st->world);
+    pose__skin_palette(rig->joint_count, st->skin, st->palette);
+    pose__pool_run(st->pool, skin_task, st);
+    pose__pool_run(st->pool, transfer_task, st);
+    return POSE_OK;
+}
+
+const float *pose_tissue_positions(const pose_state *st, int tissue, size_t *vertex_count)
+{
+    if (!st || tissue < 0 || (size_t)tissue >= st->rig->tissue_count)
+        return NULL;
+    if (vertex_count)
+        *vertex_count = st->rig->tissues[tissue].vertex_count;
+    return st->tissue_positions + 3 * st->rt->tissue_offset[tissue];
+}
+
+const float *pose_tissue_normals(const pose_state *st, int tissue, size_t *vertex_count)
+{
+    if (!st || tissue < 0 || (size_t)tissue >= st->rig->tissue_count)
+        return NULL;
+    if (vertex_count)
+        *vertex_count = st->rig->tissues[tissue].vertex_count;
+    return st->tissue_normals + 3 * st->rt->tissue_offset[tissue];
+}
+
+const float *pose_tet_positions(const pose_state *st, size_t *vertex_count)
+{
+    if (!st)
+        return NULL;
+    if (vertex_count)
+        *vertex_count = st->rig->tet_vertex_count;
+    return st->tet_positions;
+}
+
+pose_status pose_joint_world(const pose_state *st, int joint, pose_transform *out)
+{
+    pose__clear_error();
+    if (!st || !out || joint < 0 || (size_t)joint >= st->rig->joint_count)
+        return pose__fail(POSE_ERR_INVALID_ARGUMENT, "pose_joint_world: bad %s",
+                          !st ? "state" : !out ? "output" : "joint index");
+    memcpy(out->rotation, st->world[joint].q, sizeof out->rotation);
+    memcpy(out->translation, st->world[joint].t, sizeof out->translation);
+    return POSE_OK;
+}

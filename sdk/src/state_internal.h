@@ -1,0 +1,40 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* struct pose_state: one posed instance of a rig. Every buffer is allocated
+ * at creation with the state's allocator (64-byte aligned), so pose_apply
+ * allocates nothing. */
+#ifndef POSE_STATE_INTERNAL_H
+#define POSE_STATE_INTERNAL_H
+
+#include <stddef.h>
+
+#include "pose/pose.h"
+#include "rig_internal.h"
+#include "rig_runtime.h"
+#include "rt_pool.h"
+#include "rt_quat.h"
+#include "rt_skin.h"
+
+struct pose_state {
+    const pose_rig *rig;
+    const struct pose__rig_runtime *rt;
+    pose_allocator allocator;
+    pose_method method;
+
+    float (*local)[4];          /**< joint_count local rotations relative to rest */
+    pose__xform root;           /**< model placement on top of the roots */
+    pose__xform *skin;          /**< joint_count: rest -> posed, model space */
+    pose__xform *world;         /**< joint_count: posed joint frames */
+    pose__skin_joint *palette;  /**< joint_count: what the skinning kernels read */
+
+    float *tet_positions;       /**< 3 * tet vertices */
+    float *tissue_positions;    /**< 3 * all tissue vertices (rt->tissue_offset) */
+    float *tissue_normals;      /**< same layout */
+
+    pose__pool *pool;           /**< own allocation: replaced by pose_set_threads */
+    void *block;                /**< the allocation holding everything else */
+};
+
+/** Joint rotation setters' shared tail: clamp q to joint j's limits, store it. */
+pose_status pose__state_store_joint(pose_state *st, int joint, float q[4]);
+
+#endif /* POSE_STATE_INTERNAL_H */
