@@ -1,0 +1,392 @@
+/* SPDX-License-Identifier: Apache-2.0
+ *
+ * pose-view: an interactive viewer for a rig (GLFW, legacy OpenGL). Orbit,
+ * pan and zoom; show or hide tissues; colour the tet mesh by a joint's
+ * weight; switch LBS/DQS/CoR; pick a joint and rotate it (the rig's limits
+ * apply); drive the pose from a bridge source with play/pause/step/seek.
+ */
+#include <GLFW/glfw3.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ex_args.h"
+#include "ex_camera.h"
+#include "ex_draw.h"
+#include "ex_motion.h"
+#include "ex_scene.h"
+
+typedef struct viewer {
+    ex_scene sc;
+    ex_camera cam;
+    ex_motion *motion;
+    int joint;           /* selected joint */
+    float (*euler)[3];   /* per joint, the hand-set angles in degrees */
+    int playing;
+    double play_t;       /* seconds into the source */
+    double speed;
+    int show_joints, show_help;
+    double fps, last_mouse[2];
+    int dragging;        /* 0, 1 orbit, 2 pan */
+    char status[1024];
+} viewer;
+
+static void usage(FILE *f)
+{
+    fputs("usage: pose-view RIG [options]\n"
+          "Interactive viewer (needs a display).\n"
+          "  --source FILE           drive the pose from a source through the bridge\n"
+          "                          (BVH, ASF/AMC, HID or CAN recording, device)\n"
+          "  --map FILE              the bridge mapping file for --source\n"
+          "  --method lbs|dqs|cor    initial skinning method\n"
+          "  --pose JOINT=RX,RY,RZ   initial joint angles (degrees; repeatable)\n"
+          "  --size WxH              window size (default 1280x800)\n"
+          "  -h, --help              this text\n"
+          "Keys: mouse drag orbit, right drag pan, wheel zoom | 1 LBS 2 DQS 3 CoR | S skin\n"
+          "  (translucent/opaque/hidden) B bones M muscles O organs T other | W weights of the\n"
+          "  selected joint | [ ] select joint | X/Y/Z rotate +5 deg (Shift: -5) | R reset |\n"
+          "  J joints | Space play/pause . step , back Home start Left/Right seek 1 s | F frame all |\n"
+          "  H help | Esc quit\n",
+          f);
+}
+
+static void toggle_kind(viewer *v, pose_tissue_kind kind)
+{
+    int any_visible = 0;
+    for (size_t t = 0; t < v->sc.tissue_count; t++) {
+        pose_tissue_info ti;
+        if (pose_rig_tissue_info(v->sc.rig, (int)t, &ti) == POSE_OK && ti.kind == kind && v->sc.tissue_visible[t])
+            any_visible = 1;
+    }
+    for (size_t t = 0; t < v->sc.tissue_count; t++) {
+        pose_tissue_info ti;
+        if (pose_rig_tissue_info(v->sc.rig, (int)t, &ti) == POSE_OK && ti.kind == kind)
+            v->sc.tissue_visible[t] = (unsigned char)!any_visible;
+    }
+}
+
+static void joint_name(const viewer *v, char *out, size_t n)
+{
+    pose_joint_info ji;
+    snprintf(out, n, "%s", pose_rig_joint_info(v->sc.rig, v->joint, &ji) == POSE_OK ? ji.name : "?");
+}
+
+static void rotate_selected(viewer *v, int axis, float step)
+{
+    char name[64];
+    v->euler[v->joint][axis] += step;
+    pose_status st = pose_set_joint_euler(v->sc.state, v->joint, v->euler[v->joint], POSE_EULER_XYZ);
+    joint_name(v, name, sizeof name);
+    if (st == POSE_CLAMPED) {
+        /* Keep the angles the rig accepted, so further presses start from the limit. */
+        v->euler[v->joint][axis] -= step;
+        pose_set_joint_euler(v->sc.state, v->joint, v->euler[v->joint], POSE_EULER_XYZ);
+        snprintf(v->status, sizeof v->status, "%s: at its limit (%s)", name, pose_last_error());
+    } else if (st < 0) {
+        snprintf(v->status, sizeof v->status, "%s: %s", name, pose_last_error());
+    } else {
+        snprintf(v->status, sizeof v->status, "%s = %.0f, %.0f, %.0f deg", name, v->euler[v->joint][0],
+                 v->euler[v->joint][1], v->euler[v->joint][2]);
+    }
+}
+
+static void seek(viewer *v, double t)
+{
+    if (!v->motion)
+        return;
+    long n = ex_motion_frame_count(v->motion);
+    double dt = ex_motion_frame_time(v->motion);
+    double end = n > 0 && dt > 0.0 ? (double)(n - 1) * dt : 0.0;
+    v->play_t = t < 0.0 ? 0.0 : (n > 0 && t > end) ? end : t;
+}
+
+static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
+{
+    (void)scancode;
+    viewer *v = glfwGetWindowUserPointer(w);
+    if (action == GLFW_RELEASE)
+        return;
+    char err[512];
+    float step = (mods & GLFW_MOD_SHIFT) ? -5.0f : 5.0f;
+    size_t nj = pose_rig_joint_count(v->sc.rig);
+    double dt = v->motion ? ex_motion_frame_time(v->motion) : 0.0;
+    switch (key) {
+    case GLFW_KEY_ESCAPE:
+    case GLFW_KEY_Q: glfwSetWindowShouldClose(w, 1); break;
+    case GLFW_KEY_1:
+    case GLFW_KEY_2:
+    case GLFW_KEY_3:
+        if (pose_set_method(v->sc.state, (pose_method)(key - GLFW_KEY_1)) < 0)
+            snprintf(v->status, sizeof v->status, "%s", pose_last_error());
+        else
+            snprintf(v->status, sizeof v->status, "method %s", ex_method_name(pose_get_method(v->sc.state)));
+        break;
+    case GLFW_KEY_S: v->sc.skin_mode = v->sc.skin_mode == EX_SKIN_HIDDEN ? EX_SKIN_TRANSLUCENT
+                                       : v->sc.skin_mode == EX_SKIN_OPAQUE ? EX_SKIN_HIDDEN
+                                       : v->sc.skin_mode == EX_SKIN_TRANSLUCENT ? EX_SKIN_OPAQUE
+                                       : ex_scene_skin_translucent(&v->sc) ? EX_SKIN_OPAQUE : EX_SKIN_HIDDEN;
+        break;
+    case GLFW_KEY_B: toggle_kind(v, POSE_TISSUE_BONE); break;
+    case GLFW_KEY_M: toggle_kind(v, POSE_TISSUE_MUSCLE); break;
+    case GLFW_KEY_O: toggle_kind(v, POSE_TISSUE_ORGAN); break;
+    case GLFW_KEY_T: toggle_kind(v, POSE_TISSUE_OTHER); break;
+    case GLFW_KEY_W:
+        if (ex_scene_set_weight_joint(&v->sc, v->sc.weight_joint >= 0 ? -1 : v->joint, err, sizeof err) < 0)
+            snprintf(v->status, sizeof v->status, "%s", err);
+        break;
+    case GLFW_KEY_LEFT_BRACKET:
+    case GLFW_KEY_RIGHT_BRACKET:
+        v->joint = (int)(((size_t)v->joint + (key == GLFW_KEY_LEFT_BRACKET ? nj - 1 : 1)) % nj);
+        if (v->sc.weight_joint >= 0)
+            ex_scene_set_weight_joint(&v->sc, v->joint, err, sizeof err);
+        joint_name(v, err, sizeof err);
+        snprintf(v->status, sizeof v->status, "selected %s", err);
+        break;
+    case GLFW_KEY_X: rotate_selected(v, 0, step); break;
+    case GLFW_KEY_Y: rotate_selected(v, 1, step); break;
+    case GLFW_KEY_Z: rotate_selected(v, 2, step); break;
+    case GLFW_KEY_R:
+        pose_reset(v->sc.state);
+        memset(v->euler, 0, nj * sizeof *v->euler);
+        snprintf(v->status, sizeof v->status, "rest pose");
+        break;
+    case GLFW_KEY_J: v->show_joints = !v->show_joints; break;
+    case GLFW_KEY_H: v->show_help = !v->show_help; break;
+    case GLFW_KEY_F: {
+        float bmin[3], bmax[3];
+        int fw, fh;
+        glfwGetFramebufferSize(w, &fw, &fh);
+        ex_scene_bounds(&v->sc, 1, bmin, bmax);
+        ex_camera_frame(&v->cam, bmin, bmax, fh > 0 ? (float)fw / (float)fh : 1.0f);
+        break;
+    }
+    case GLFW_KEY_SPACE: v->playing = !v->playing; break;
+    case GLFW_KEY_PERIOD: v->playing = 0; seek(v, v->play_t + (dt > 0.0 ? dt : 1.0 / 30.0)); break;
+    case GLFW_KEY_COMMA: v->playing = 0; seek(v, v->play_t - (dt > 0.0 ? dt : 1.0 / 30.0)); break;
+    case GLFW_KEY_HOME: seek(v, 0.0); break;
+    case GLFW_KEY_RIGHT: seek(v, v->play_t + 1.0); break;
+    case GLFW_KEY_LEFT: seek(v, v->play_t - 1.0); break;
+    default: break;
+    }
+}
+
+static void on_button(GLFWwindow *w, int button, int action, int mods)
+{
+    (void)mods;
+    viewer *v = glfwGetWindowUserPointer(w);
+    if (action == GLFW_PRESS) {
+        v->dragging = button == GLFW_MOUSE_BUTTON_LEFT ? 1 : 2;
+        glfwGetCursorPos(w, &v->last_mouse[0], &v->last_mouse[1]);
+    } else {
+        v->dragging = 0;
+    }
+}
+
+static void on_cursor(GLFWwindow *w, double x, double y)
+{
+    viewer *v = glfwGetWindowUserPointer(w);
+    double dx = x - v->last_mouse[0], dy = y - v->last_mouse[1];
+    v->last_mouse[0] = x;
+    v->last_mouse[1] = y;
+    if (v->dragging == 1) {
+        v->cam.azimuth_deg -= (float)dx * 0.4f;
+        v->cam.elevation_deg += (float)dy * 0.4f;
+        if (v->cam.elevation_deg > 89.0f)
+            v->cam.elevation_deg = 89.0f;
+        if (v->cam.elevation_deg < -89.0f)
+            v->cam.elevation_deg = -89.0f;
+    } else if (v->dragging == 2) {
+        ex_camera_pan(&v->cam, -(float)dx * 0.0015f, (float)dy * 0.0015f);
+    }
+}
+
+static void on_scroll(GLFWwindow *w, double dx, double dy)
+{
+    (void)dx;
+    viewer *v = glfwGetWindowUserPointer(w);
+    v->cam.distance *= powf(0.9f, (float)dy);
+}
+
+static void hud(viewer *v, int fw, int fh)
+{
+    static const float white[4] = {0.92f, 0.92f, 0.92f, 1.0f}, dim[4] = {0.7f, 0.75f, 0.8f, 1.0f};
+    char line[512], name[64];
+    joint_name(v, name, sizeof name);
+    snprintf(line, sizeof line, "%.0f fps  pose_apply %.2f ms  %s  joint %s%s", v->fps, v->sc.last_apply_ms,
+             ex_method_name(pose_get_method(v->sc.state)), name,
+             v->sc.weight_joint >= 0 ? "  (weights)" : "");
+    ex_draw_text(10, 10, 2, white, line, fw, fh);
+    if (v->motion) {
+        double dt = ex_motion_frame_time(v->motion);
+        snprintf(line, sizeof line, "%s  t %.2f s  frame %ld/%ld  %s", ex_motion_status(v->motion), v->play_t,
+                 dt > 0.0 ? (long)(v->play_t / dt + 0.5) : 0L, ex_motion_frame_count(v->motion),
+                 v->playing ? "playing" : "paused");
+        ex_draw_text(10, 30, 2, dim, line, fw, fh);
+    }
+    if (v->status[0])
+        ex_draw_text(10, fh - 24, 2, dim, v->status, fw, fh);
+    if (v->show_help) {
+        static const char *help[] = {
+            "drag: orbit   right drag: pan   wheel: zoom   F: frame all",
+            "1/2/3: LBS/DQS/CoR   S: skin   B/M/O/T: bones/muscles/organs/other",
+            "[ ]: select joint   X/Y/Z: rotate +5 (shift -5)   R: reset   J: joints",
+            "W: weights of joint   space: play   . , : step   left/right: seek 1 s",
+            "H: hide this help   Esc: quit"};
+        for (int i = 0; i < 5; i++)
+            ex_draw_text(10, 56 + 18 * i, 2, dim, help[i], fw, fh);
+    }
+}
+
+int main(int argc, char **argv)
+{
+    const char *rig = NULL, *source = NULL, *map = NULL, *poses[64];
+    int npose = 0, method = -1, width = 1280, height = 800;
+    char err[1024] = "";
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            usage(stdout);
+            return 0;
+        }
+        if (a[0] != '-') {
+            if (rig) {
+                fprintf(stderr, "pose-view: unexpected argument '%s' (one rig only)\n", a);
+                return 2;
+            }
+            rig = a;
+            continue;
+        }
+        if (!val) {
+            fprintf(stderr, "pose-view: %s needs a value (see --help)\n", a);
+            return 2;
+        }
+        i++;
+        if (!strcmp(a, "--source"))
+            source = val;
+        else if (!strcmp(a, "--map"))
+            map = val;
+        else if (!strcmp(a, "--pose") && npose < 64)
+            poses[npose++] = val;
+        else if (!strcmp(a, "--method") && (method = ex_parse_method(val)) >= 0)
+            ;
+        else if (!strcmp(a, "--size") && ex_parse_size(a, val, &width, &height, err, sizeof err) == 0)
+            ;
+        else {
+            fprintf(stderr, "pose-view: bad option '%s %s' (see --help)%s%s\n", a, val, err[0] ? ": " : "", err);
+            return 2;
+        }
+    }
+    if (!rig) {
+        fprintf(stderr, "pose-view: no rig given (usage: pose-view RIG [options]; see --help)\n");
+        return 2;
+    }
+
+    viewer v;
+    memset(&v, 0, sizeof v);
+    v.speed = 1.0;
+    v.show_help = 1;
+    if (ex_scene_open(&v.sc, rig, err, sizeof err) < 0) {
+        fprintf(stderr, "pose-view: %s\n", err);
+        return 1;
+    }
+    int rc = 1;
+    GLFWwindow *win = NULL;
+    v.euler = calloc(pose_rig_joint_count(v.sc.rig) + 1, sizeof *v.euler);
+    if (!v.euler) {
+        snprintf(err, sizeof err, "out of memory");
+        goto done;
+    }
+    if (method >= 0 && pose_set_method(v.sc.state, (pose_method)method) < 0) {
+        snprintf(err, sizeof err, "--method: %s", pose_last_error());
+        goto done;
+    }
+    for (int i = 0; i < npose; i++)
+        if (ex_scene_set_pose_arg(&v.sc, poses[i], err, sizeof err) < 0)
+            goto done;
+    if (source) {
+        if (ex_motion_open(source, map, v.sc.rig, &v.motion, err, sizeof err) < 0)
+            goto done;
+        v.playing = 1;
+    }
+    /* Check for a display before GLFW does, to say what is missing in plain words. */
+    const char *display = getenv("DISPLAY"), *wayland = getenv("WAYLAND_DISPLAY");
+    if ((!display || !*display) && (!wayland || !*wayland)) {
+        snprintf(err, sizeof err, "no display (DISPLAY and WAYLAND_DISPLAY are unset); for images without a "
+                                  "display use pose-render");
+        goto done;
+    }
+    if (!glfwInit()) {
+        const char *desc = NULL;
+        glfwGetError(&desc);
+        snprintf(err, sizeof err, "cannot open the display: %s (for images without a display use pose-render)",
+                 desc ? desc : "glfwInit failed");
+        goto done;
+    }
+    glfwWindowHint(GLFW_SAMPLES, 4);
+    char title[512];
+    snprintf(title, sizeof title, "pose-view - %s", rig);
+    win = glfwCreateWindow(width, height, title, NULL, NULL);
+    if (!win) {
+        const char *desc = NULL;
+        glfwGetError(&desc);
+        snprintf(err, sizeof err, "cannot create an OpenGL window: %s", desc ? desc : "unknown error");
+        goto done;
+    }
+    glfwMakeContextCurrent(win);
+    glfwSwapInterval(1);
+    glfwSetWindowUserPointer(win, &v);
+    glfwSetKeyCallback(win, on_key);
+    glfwSetMouseButtonCallback(win, on_button);
+    glfwSetCursorPosCallback(win, on_cursor);
+    glfwSetScrollCallback(win, on_scroll);
+    {
+        float bmin[3], bmax[3];
+        ex_scene_bounds(&v.sc, 1, bmin, bmax);
+        ex_camera_frame(&v.cam, bmin, bmax, (float)width / (float)height);
+    }
+    v.joint = pose_rig_joint_count(v.sc.rig) > 1 ? 1 : 0;
+    double last = glfwGetTime(), fps_t = last;
+    int frames = 0;
+    while (!glfwWindowShouldClose(win)) {
+        double now = glfwGetTime();
+        if (v.motion && v.playing) {
+            seek(&v, v.play_t + (now - last) * v.speed);
+            long n = ex_motion_frame_count(v.motion);
+            double dt = ex_motion_frame_time(v.motion);
+            if (n > 0 && dt > 0.0 && v.play_t >= (double)(n - 1) * dt)
+                v.play_t = 0.0; /* loop */
+        }
+        last = now;
+        if (v.motion && ex_motion_set_time(v.motion, v.sc.state, v.play_t, err, sizeof err) < 0)
+            snprintf(v.status, sizeof v.status, "%s", err);
+        if (ex_scene_apply(&v.sc, err, sizeof err) < 0)
+            goto done;
+        int fw, fh;
+        glfwGetFramebufferSize(win, &fw, &fh);
+        static const float bg[3] = {0.13f, 0.14f, 0.17f};
+        ex_draw_scene(&v.sc, &v.cam, fw, fh, bg);
+        if (v.show_joints)
+            ex_draw_joints(&v.sc, v.joint);
+        hud(&v, fw, fh);
+        glfwSwapBuffers(win);
+        glfwPollEvents();
+        frames++;
+        if (now - fps_t >= 0.5) {
+            v.fps = frames / (now - fps_t);
+            frames = 0;
+            fps_t = now;
+        }
+    }
+    rc = 0;
+done:
+    if (rc)
+        fprintf(stderr, "pose-view: %s\n", err);
+    if (win)
+        glfwDestroyWindow(win);
+    glfwTerminate();
+    ex_motion_close(v.motion);
+    free(v.euler);
+    ex_scene_close(&v.sc);
+    return rc;
+}
