@@ -1,0 +1,465 @@
+/* SPDX-License-Identifier: Apache-2.0
+ *
+ * Skeleton template reader. cJSON does the JSON; this file checks the
+ * meaning: every key known, names unique and short, parents before children,
+ * each bone in one segment only, numbers finite and in range. Errors name the
+ * file, the line (of the JSON error, or of the offending joint's name) and
+ * the field.
+ */
+#include "template_json.h"
+
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct parse_ctx {
+    const char *text;
+    size_t size;
+    const char *source;
+    char *err;
+    size_t err_size;
+} parse_ctx;
+
+static int line_of_offset(const char *text, size_t offset)
+{
+    int line = 1;
+    for (size_t i = 0; i < offset; i++)
+        line += text[i] == '\n';
+    return line;
+}
+
+/* Line where a joint is declared: the first occurrence of its quoted name
+ * after "name". cJSON keeps no positions, and naming the line saves the
+ * user a search in a 300-line file. 0 if not found. */
+static int line_of_joint(const parse_ctx *c, const char *name)
+{
+    char needle[PP_NAME_MAX + 3];
+    snprintf(needle, sizeof needle, "\"%s\"", name);
+    size_t n = strlen(needle);
+    for (size_t i = 0; i + n <= c->size; i++)
+        if (memcmp(c->text + i, needle, n) == 0)
+            return line_of_offset(c->text, i);
+    return 0;
+}
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 4, 5)))
+#endif
+static int fail_at(const parse_ctx *c, int status, const char *joint, const char *fmt, ...)
+{
+    char what[384];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    int line = joint ? line_of_joint(c, joint) : 0;
+    if (!c->err || !c->err_size)
+        return status;
+    if (joint && line > 0)
+        snprintf(c->err, c->err_size, "%s:%d: joint '%s': %s", c->source, line, joint, what);
+    else if (joint)
+        snprintf(c->err, c->err_size, "%s: joint '%s': %s", c->source, joint, what);
+    else
+        snprintf(c->err, c->err_size, "%s: %s", c->source, what);
+    return status;
+}
+
+const char *pp_fit_rule_name(pp_fit_rule rule)
+{
+    switch (rule) {
+    case PP_FIT_ROOT: return "root";
+    case PP_FIT_BALL: return "ball";
+    case PP_FIT_HINGE: return "hinge";
+    case PP_FIT_SPINE: return "spine";
+    case PP_FIT_FIXED: return "fixed";
+    }
+    return "?";
+}
+
+static int parse_rule(const char *s, pp_fit_rule *out)
+{
+    static const pp_fit_rule all[] = {PP_FIT_ROOT, PP_FIT_BALL, PP_FIT_HINGE, PP_FIT_SPINE,
+                                      PP_FIT_FIXED};
+    for (size_t i = 0; i < sizeof all / sizeof all[0]; i++)
+        if (strcmp(s, pp_fit_rule_name(all[i])) == 0) {
+            *out = all[i];
+            return 1;
+        }
+    return 0;
+}
+
+static int parse_order(const char *s, pose_euler_order *out)
+{
+    static const char *names[] = {"XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX"};
+    for (int i = 0; i < 6; i++)
+        if (strcmp(s, names[i]) == 0) {
+            *out = (pose_euler_order)i;
+            return 1;
+        }
+    return 0;
+}
+
+/* A JSON array of exactly n finite numbers. */
+static int read_vec(const cJSON *item, float *out, int n)
+{
+    if (!cJSON_IsArray(item) || cJSON_GetArraySize(item) != n)
+        return 0;
+    int i = 0;
+    for (const cJSON *e = item->child; e; e = e->next, i++) {
+        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble) || fabs(e->valuedouble) > 1e6)
+            return 0;
+        out[i] = (float)e->valuedouble;
+    }
+    return 1;
+}
+
+static int read_unit_vec(const cJSON *item, float out[3])
+{
+    if (!read_vec(item, out, 3))
+        return 0;
+    float n = sqrtf(out[0] * out[0] + out[1] * out[1] + out[2] * out[2]);
+    if (!(n > 1e-6f))
+        return 0;
+    for (int k = 0; k < 3; k++)
+        out[k] /= n;
+    return 1;
+}
+
+static int valid_name(const char *s)
+{
+    size_t n = strlen(s);
+    return n >= 1 && n < PP_NAME_MAX;
+}
+
+/* An array of mesh names into a fresh array (count may be 0). */
+static int read_names(const parse_ctx *c, const char *joint, const char *field, const cJSON *arr,
+                      char (**out)[PP_NAME_MAX], size_t *count)
+{
+    *out = NULL;
+    *count = 0;
+    if (!cJSON_IsArray(arr))
+        return fail_at(c, POSE_ERR_FORMAT, joint, "'%s' must be an array of mesh names", field);
+    int n = cJSON_GetArraySize(arr);
+    if (n == 0)
+        return POSE_OK;
+    *out = calloc((size_t)n, sizeof **out);
+    if (!*out)
+        return fail_at(c, POSE_ERR_OUT_OF_MEMORY, joint, "out of memory");
+    for (const cJSON *e = arr->child; e; e = e->next) {
+        if (!cJSON_IsString(e) || !valid_name(e->valuestring))
+            return fail_at(c, POSE_ERR_FORMAT, joint,
+                           "'%s' entry %zu must be a mesh name of 1..63 bytes", field, *count);
+        for (size_t k = 0; k < *count; k++)
+            if (strcmp((*out)[k], e->valuestring) == 0)
+                return fail_at(c, POSE_ERR_INVALID_DATA, joint, "'%s' lists '%s' twice", field,
+                               e->valuestring);
+        strcpy((*out)[(*count)++], e->valuestring);
+    }
+    return POSE_OK;
+}
+
+static int in_list(char (*list)[PP_NAME_MAX], size_t n, const char *s)
+{
+    for (size_t i = 0; i < n; i++)
+        if (strcmp(list[i], s) == 0)
+            return 1;
+    return 0;
+}
+
+static int parse_limits(const parse_ctx *c, const char *joint, const cJSON *lim,
+                        pp_template_joint *j)
+{
+    if (!cJSON_IsObject(lim))
+        return fail_at(c, POSE_ERR_FORMAT, joint, "'limits' must be an object");
+    static const char *axes[3] = {"x", "y", "z"};
+    for (const cJSON *e = lim->child; e; e = e->next) {
+        if (strcmp(e->string, "order") == 0) {
+            if (!cJSON_IsString(e) || !parse_order(e->valuestring, &j->limit_order))
+                return fail_at(c, POSE_ERR_FORMAT, joint,
+                               "'limits.order' must be one of XYZ XZY YXZ YZX ZXY ZYX");
+            continue;
+        }
+        int a = -1;
+        for (int k = 0; k < 3; k++)
+            if (strcmp(e->string, axes[k]) == 0)
+                a = k;
+        if (a < 0)
+            return fail_at(c, POSE_ERR_FORMAT, joint, "unknown key 'limits.%s' (expected order, x, y, z)",
+                           e->string);
+        float mm[2];
+        if (!read_vec(e, mm, 2) || mm[0] > mm[1] || mm[0] < -180.0f || mm[1] > 180.0f)
+            return fail_at(c, POSE_ERR_FORMAT, joint,
+                           "'limits.%s' must be [min, max] degrees with -180 <= min <= max <= 180",
+                           e->string);
+        j->limit_flags |= 1u << a;
+        j->limit_min_deg[a] = mm[0];
+        j->limit_max_deg[a] = mm[1];
+    }
+    return POSE_OK;
+}
+
+static int parse_joint(const parse_ctx *c, const cJSON *obj, size_t index, pp_template *t,
+                       float default_contact_mm)
+{
+    pp_template_joint *j = &t->joints[index];
+    char label[PP_NAME_MAX + 16];
+    snprintf(label, sizeof label, "#%zu", index);
+    if (!cJSON_IsObject(obj))
+        return fail_at(c, POSE_ERR_FORMAT, NULL, "joints[%zu] must be an object", index);
+    const cJSON *name = cJSON_GetObjectItemCaseSensitive(obj, "name");
+    if (!cJSON_IsString(name) || !valid_name(name->valuestring))
+        return fail_at(c, POSE_ERR_FORMAT, NULL, "joints[%zu]: 'name' must be a string of 1..63 bytes",
+                       index);
+    strcpy(j->name, name->valuestring);
+    const char *jn = j->name;
+    for (size_t k = 0; k < index; k++)
+        if (strcmp(t->joints[k].name, jn) == 0)
+            return fail_at(c, POSE_ERR_INVALID_DATA, jn, "name used twice");
+
+    j->parent = -1;
+    j->contact_mm = default_contact_mm;
+    j->axis[1] = 1.0f;
+    j->up[2] = 1.0f;
+    j->limit_order = POSE_EULER_XYZ;
+    int have_rule = 0, have_bones = 0;
+    for (const cJSON *e = obj->child; e; e = e->next) {
+        const char *key = e->string;
+        int rc = POSE_OK;
+        if (strcmp(key, "name") == 0) {
+            continue;
+        } else if (strcmp(key, "parent") == 0) {
+            if (cJSON_IsNull(e))
+                continue;
+            if (!cJSON_IsString(e))
+                return fail_at(c, POSE_ERR_FORMAT, jn, "'parent' must be a joint name or null");
+            for (size_t k = 0; k < index; k++)
+                if (strcmp(t->joints[k].name, e->valuestring) == 0)
+                    j->parent = (int)k;
+            if (j->parent < 0)
+                return fail_at(c, POSE_ERR_INVALID_DATA, jn,
+                               "parent '%s' is not a joint listed before this one", e->valuestring);
+        } else if (strcmp(key, "rule") == 0) {
+            if (!cJSON_IsString(e) || !parse_rule(e->valuestring, &j->rule))
+                return fail_at(c, POSE_ERR_FORMAT, jn,
+                               "'rule' must be one of root, ball, hinge, spine, fixed");
+            have_rule = 1;
+        } else if (strcmp(key, "bones") == 0) {
+            rc = read_names(c, jn, key, e, &j->bones, &j->bone_count);
+            have_bones = 1;
+        } else if (strcmp(key, "contact") == 0) {
+            rc = read_names(c, jn, key, e, &j->contact, &j->contact_count);
+        } else if (strcmp(key, "parent_contact") == 0) {
+            rc = read_names(c, jn, key, e, &j->parent_contact, &j->parent_contact_count);
+        } else if (strcmp(key, "fit") == 0) {
+            if (cJSON_IsString(e) && strcmp(e->valuestring, "child") == 0)
+                j->side = PP_SIDE_CHILD;
+            else if (cJSON_IsString(e) && strcmp(e->valuestring, "parent") == 0)
+                j->side = PP_SIDE_PARENT;
+            else if (cJSON_IsString(e) && strcmp(e->valuestring, "both") == 0)
+                j->side = PP_SIDE_BOTH;
+            else
+                return fail_at(c, POSE_ERR_FORMAT, jn, "'fit' must be child, parent or both");
+        } else if (strcmp(key, "contact_mm") == 0) {
+            if (!cJSON_IsNumber(e) || !(e->valuedouble > 0.0 && e->valuedouble <= 100.0))
+                return fail_at(c, POSE_ERR_FORMAT, jn, "'contact_mm' must be a number in (0, 100]");
+            j->contact_mm = (float)e->valuedouble;
+        } else if (strcmp(key, "grow_mm") == 0) {
+            if (!cJSON_IsNumber(e) || !(e->valuedouble > 0.0 && e->valuedouble <= 200.0))
+                return fail_at(c, POSE_ERR_FORMAT, jn, "'grow_mm' must be a number in (0, 200]");
+            j->grow_mm = (float)e->valuedouble;
+        } else if (strcmp(key, "axis") == 0) {
+            if (!read_unit_vec(e, j->axis))
+                return fail_at(c, POSE_ERR_FORMAT, jn, "'axis' must be a non-zero [x, y, z]");
+        } else if (strcmp(key, "up") == 0) {
+            if (!read_unit_vec(e, j->up))
+                return fail_at(c, POSE_ERR_FORMAT, jn, "'up' must be a non-zero [x, y, z]");
+        } else if (strcmp(key, "at") == 0) {
+            if (!read_vec(e, j->at, 3))
+                return fail_at(c, POSE_ERR_FORMAT, jn, "'at' must be [x, y, z] in metres");
+            j->has_at = 1;
+        } else if (strcmp(key, "limits") == 0) {
+            rc = parse_limits(c, jn, e, j);
+        } else if (strcmp(key, "comment") == 0) {
+            continue;
+        } else {
+            return fail_at(c, POSE_ERR_FORMAT, jn, "unknown key '%s'", key);
+        }
+        if (rc < 0)
+            return rc;
+    }
+    if (!have_rule)
+        return fail_at(c, POSE_ERR_FORMAT, jn, "missing 'rule'");
+    if (!have_bones || j->bone_count == 0)
+        return fail_at(c, POSE_ERR_FORMAT, jn, "missing or empty 'bones' (the segment's meshes)");
+    if ((j->rule == PP_FIT_ROOT) != (j->parent < 0))
+        return fail_at(c, POSE_ERR_INVALID_DATA, jn,
+                       j->parent < 0 ? "a joint without parent must have rule 'root'"
+                                     : "rule 'root' is only for a joint without parent");
+    if (j->rule == PP_FIT_FIXED && !j->has_at)
+        return fail_at(c, POSE_ERR_FORMAT, jn, "rule 'fixed' needs 'at'");
+    for (size_t k = 0; k < j->contact_count; k++)
+        if (!in_list(j->bones, j->bone_count, j->contact[k]))
+            return fail_at(c, POSE_ERR_INVALID_DATA, jn, "'contact' names '%s', which is not in 'bones'",
+                           j->contact[k]);
+    if (j->parent >= 0) {
+        const pp_template_joint *p = &t->joints[j->parent];
+        for (size_t k = 0; k < j->parent_contact_count; k++)
+            if (!in_list(p->bones, p->bone_count, j->parent_contact[k]))
+                return fail_at(c, POSE_ERR_INVALID_DATA, jn,
+                               "'parent_contact' names '%s', which is not in parent '%s' bones",
+                               j->parent_contact[k], p->name);
+    }
+    for (size_t b = 0; b < j->bone_count; b++)
+        for (size_t k = 0; k < index; k++)
+            if (in_list(t->joints[k].bones, t->joints[k].bone_count, j->bones[b]))
+                return fail_at(c, POSE_ERR_INVALID_DATA, jn, "bone '%s' is already in joint '%s'",
+                               j->bones[b], t->joints[k].name);
+    return POSE_OK;
+}
+
+int pp_template_parse(const char *text, size_t size, const char *source, pp_template *out,
+                      char *err, size_t err_size)
+{
+    parse_ctx c = {text, size, source ? source : "<template>", err, err_size};
+    memset(out, 0, sizeof *out);
+    if (err && err_size)
+        err[0] = '\0';
+    if (!text)
+        return fail_at(&c, POSE_ERR_INVALID_ARGUMENT, NULL, "no text");
+    const char *end = NULL;
+    cJSON *root = cJSON_ParseWithLengthOpts(text, size, &end, 0);
+    if (!root) {
+        size_t off = end && end >= text && end <= text + size ? (size_t)(end - text) : 0;
+        return fail_at(&c, POSE_ERR_FORMAT, NULL, "line %d (offset %zu): not valid JSON",
+                       line_of_offset(text, off), off);
+    }
+    int rc = POSE_OK;
+    if (!cJSON_IsObject(root)) {
+        rc = fail_at(&c, POSE_ERR_FORMAT, NULL, "the top level must be an object");
+        goto done;
+    }
+    const cJSON *fmt = cJSON_GetObjectItemCaseSensitive(root, "format");
+    if (!cJSON_IsString(fmt) || strcmp(fmt->valuestring, "pose-skeleton-template") != 0) {
+        rc = fail_at(&c, POSE_ERR_FORMAT, NULL,
+                     "'format' must be \"pose-skeleton-template\" (is this a skeleton template?)");
+        goto done;
+    }
+    const cJSON *ver = cJSON_GetObjectItemCaseSensitive(root, "version");
+    if (!cJSON_IsNumber(ver) || ver->valuedouble != 1.0) {
+        rc = fail_at(&c, POSE_ERR_VERSION, NULL, "'version' must be 1 (this pose-bake reads version 1)");
+        goto done;
+    }
+    float contact_mm = 4.0f;
+    const cJSON *joints = NULL;
+    for (const cJSON *e = root->child; e; e = e->next) {
+        if (strcmp(e->string, "format") == 0 || strcmp(e->string, "version") == 0 ||
+            strcmp(e->string, "comment") == 0 || strcmp(e->string, "description") == 0) {
+            continue;
+        } else if (strcmp(e->string, "name") == 0) {
+            if (!cJSON_IsString(e) || !valid_name(e->valuestring)) {
+                rc = fail_at(&c, POSE_ERR_FORMAT, NULL, "'name' must be a string of 1..63 bytes");
+                goto done;
+            }
+            strcpy(out->name, e->valuestring);
+        } else if (strcmp(e->string, "contact_mm") == 0) {
+            if (!cJSON_IsNumber(e) || !(e->valuedouble > 0.0 && e->valuedouble <= 100.0)) {
+                rc = fail_at(&c, POSE_ERR_FORMAT, NULL, "'contact_mm' must be a number in (0, 100]");
+                goto done;
+            }
+            contact_mm = (float)e->valuedouble;
+        } else if (strcmp(e->string, "joints") == 0) {
+            joints = e;
+        } else {
+            rc = fail_at(&c, POSE_ERR_FORMAT, NULL, "unknown top-level key '%s'", e->string);
+            goto done;
+        }
+    }
+    if (!cJSON_IsArray(joints) || cJSON_GetArraySize(joints) < 1) {
+        rc = fail_at(&c, POSE_ERR_FORMAT, NULL, "'joints' must be a non-empty array");
+        goto done;
+    }
+    size_t n = (size_t)cJSON_GetArraySize(joints);
+    if (n > 1024) {
+        rc = fail_at(&c, POSE_ERR_FORMAT, NULL, "%zu joints; at most 1024", n);
+        goto done;
+    }
+    out->joints = calloc(n, sizeof *out->joints);
+    if (!out->joints) {
+        rc = fail_at(&c, POSE_ERR_OUT_OF_MEMORY, NULL, "out of memory");
+        goto done;
+    }
+    size_t i = 0;
+    for (const cJSON *e = joints->child; e; e = e->next, i++) {
+        out->joint_count = i + 1; /* so pp_template_free releases a partly read joint */
+        rc = parse_joint(&c, e, i, out, contact_mm);
+        if (rc < 0)
+            goto done;
+    }
+done:
+    cJSON_Delete(root);
+    if (rc < 0)
+        pp_template_free(out);
+    return rc;
+}
+
+int pp_template_load(const char *path, pp_template *out, char *err, size_t err_size)
+{
+    memset(out, 0, sizeof *out);
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, err_size, "%s: cannot open: %s", path, strerror(errno));
+        return POSE_ERR_IO;
+    }
+    /* Templates are small; 4 MiB is far beyond any real one and bounds memory. */
+    const size_t cap = 4u << 20;
+    char *buf = malloc(cap + 1);
+    if (!buf) {
+        fclose(f);
+        snprintf(err, err_size, "%s: out of memory", path);
+        return POSE_ERR_OUT_OF_MEMORY;
+    }
+    size_t n = fread(buf, 1, cap + 1, f);
+    int bad = ferror(f);
+    fclose(f);
+    if (bad || n > cap) {
+        free(buf);
+        snprintf(err, err_size, bad ? "%s: read error" : "%s: larger than 4 MiB; not a template", path);
+        return POSE_ERR_IO;
+    }
+    int rc = pp_template_parse(buf, n, path, out, err, err_size);
+    free(buf);
+    return rc;
+}
+
+void pp_template_free(pp_template *t)
+{
+    if (!t)
+        return;
+    for (size_t i = 0; i < t->joint_count; i++) {
+        free(t->joints[i].bones);
+        free(t->joints[i].contact);
+        free(t->joints[i].parent_contact);
+    }
+    free(t->joints);
+    memset(t, 0, sizeof *t);
+}
+
+int pp_template_find_joint(const pp_template *t, const char *name)
+{
+    for (size_t i = 0; i < t->joint_count; i++)
+        if (strcmp(t->joints[i].name, name) == 0)
+            return (int)i;
+    return -1;
+}
+
+int pp_template_joint_of_bone(const pp_template *t, const char *bone)
+{
+    for (size_t i = 0; i < t->joint_count; i++)
+        if (in_list(t->joints[i].bones, t->joints[i].bone_count, bone))
+            return (int)i;
+    return -1;
+}

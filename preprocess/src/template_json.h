@@ -1,0 +1,83 @@
+/* SPDX-License-Identifier: Apache-2.0
+ *
+ * Skeleton templates: which joints a body has, their hierarchy, the bone
+ * meshes forming each joint's segment, how each joint centre is found from
+ * the bones (the fitting rule) and default joint limits. Read from JSON
+ * (cJSON); see preprocess/templates/full_body.json for the format.
+ */
+#ifndef POSE_PP_TEMPLATE_JSON_H
+#define POSE_PP_TEMPLATE_JSON_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "pose/pose.h"
+
+#define PP_NAME_MAX 64
+
+/** How a joint's centre (and axis) is estimated from the bones. */
+typedef enum pp_fit_rule {
+    PP_FIT_ROOT = 0,  /**< the root: centroid of its segment (or "at"), world-aligned frame */
+    PP_FIT_BALL = 1,  /**< least-squares sphere of the articular contact region */
+    PP_FIT_HINGE = 2, /**< axis = principal direction of the contact region; centre on it */
+    PP_FIT_SPINE = 3, /**< centroid of the contact region between two vertebra groups */
+    PP_FIT_FIXED = 4, /**< centre given by "at" in the template (model space, metres) */
+} pp_fit_rule;
+
+/** What point set a ball/hinge centre is fitted to. */
+typedef enum pp_fit_side {
+    PP_SIDE_CHILD = 0,  /**< the child bone's vertices near the parent (default) */
+    PP_SIDE_PARENT = 1, /**< the parent bone's vertices near the child */
+    PP_SIDE_BOTH = 2,   /**< both articular surfaces */
+} pp_fit_side;
+
+typedef struct pp_template_joint {
+    char name[PP_NAME_MAX];
+    int parent;                 /**< index of an earlier joint, -1 for the root */
+    pp_fit_rule rule;
+    pp_fit_side side;
+    size_t bone_count;
+    char (*bones)[PP_NAME_MAX]; /**< the segment's bone meshes (by mesh name) */
+    size_t contact_count;       /**< 0: the whole segment takes part in the contact */
+    char (*contact)[PP_NAME_MAX]; /**< child bones used for the contact region */
+    size_t parent_contact_count; /**< 0: the whole parent segment */
+    char (*parent_contact)[PP_NAME_MAX];
+    float contact_mm;           /**< contact distance, millimetres */
+    float grow_mm;              /**< > 0: fit to the fit side's vertices within this
+                                     distance of the contact region's centroid (the whole
+                                     articular surface, when the contact strip is too
+                                     narrow an arc for a stable fit) */
+    float axis[3];              /**< approximate flexion axis (frame y), model space */
+    float up[3];                /**< approximate direction towards the parent (frame z) */
+    int has_at;
+    float at[3];                /**< fixed centre (PP_FIT_FIXED, optional for the root) */
+    uint32_t limit_flags;       /**< POSE_LIMIT_* */
+    pose_euler_order limit_order;
+    float limit_min_deg[3], limit_max_deg[3];
+} pp_template_joint;
+
+typedef struct pp_template {
+    char name[PP_NAME_MAX];
+    size_t joint_count;
+    pp_template_joint *joints;
+} pp_template;
+
+/**
+ * Parse a template from `size` bytes of JSON. `source` names the text in
+ * messages (usually the file path). On failure returns a negative
+ * pose_status, leaves *out empty and writes a message naming the source and
+ * the line, joint and field at fault into err.
+ */
+int pp_template_parse(const char *text, size_t size, const char *source, pp_template *out,
+                      char *err, size_t err_size);
+/** Read and parse a template file (pp_template_parse). */
+int pp_template_load(const char *path, pp_template *out, char *err, size_t err_size);
+void pp_template_free(pp_template *t);
+
+/** Index of the joint with this name, or -1. */
+int pp_template_find_joint(const pp_template *t, const char *name);
+/** Index of the joint whose segment holds this bone mesh, or -1 (a soft mesh). */
+int pp_template_joint_of_bone(const pp_template *t, const char *bone);
+const char *pp_fit_rule_name(pp_fit_rule rule);
+
+#endif /* POSE_PP_TEMPLATE_JSON_H */
