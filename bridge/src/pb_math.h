@@ -12,6 +12,7 @@
 
 #define PB_DEG2RAD 0.017453292519943295
 #define PB_RAD2DEG 57.29577951308232
+#define PB_PI 3.141592653589793
 
 static inline void pb_quat_identity(double q[4]) { q[0] = q[1] = q[2] = 0.0; q[3] = 1.0; }
 
