@@ -20,7 +20,7 @@ typedef enum pp_fit_rule {
     PP_FIT_ROOT = 0,  /**< the root: centroid of its segment (or "at"), world-aligned frame */
     PP_FIT_BALL = 1,  /**< least-squares sphere of the articular contact region */
     PP_FIT_HINGE = 2, /**< axis = principal direction of the contact region; centre on it */
-    PP_FIT_SPINE = 3, /**< centroid of the contact region between two vertebra groups */
+    PP_FIT_SPINE = 3, /**< centroid of the contact region (vertebra groups, saddle joints) */
     PP_FIT_FIXED = 4, /**< centre given by "at" in the template (model space, metres) */
 } pp_fit_rule;
 
