@@ -1,0 +1,14 @@
+# SPDX-License-Identifier: Apache-2.0
+# HID backend link dependencies (included by bridge/CMakeLists.txt after the
+# pose_bridge target exists). hidapi's hidraw backend (BSD/GPL/original
+# hidapi licence, used under its permissive terms) is optional: without it the
+# recordings, the decoder and the simulated devices still build; live devices
+# report POSE_ERR_UNSUPPORTED.
+pkg_check_modules(HIDAPI IMPORTED_TARGET hidapi-hidraw)
+if(HIDAPI_FOUND)
+  target_link_libraries(pose_bridge PUBLIC PkgConfig::HIDAPI)
+  target_compile_definitions(pose_bridge PRIVATE POSE_BRIDGE_HAVE_HIDAPI=1)
+else()
+  message(STATUS "pose-bridge: hidapi-hidraw not found; live HID devices disabled (recordings still work)")
+endif()
+
