@@ -1,0 +1,78 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The worker pool: every part runs exactly once per task, on the worker
+ * that owns it, with the caller's writes visible to it and its writes
+ * visible after pose__pool_run returns (run under TSan with -DPOSE_TSAN=ON). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+#include <cmocka.h>
+
+#include "rt_pool.h"
+
+enum { MAX_PARTS = 8, ITEMS = 1000 };
+
+typedef struct job {
+    int round;               /* written by the caller before each run */
+    int seen[MAX_PARTS];     /* written by part i only */
+    int runs[MAX_PARTS];
+    int data[ITEMS];
+} job;
+
+static void task(void *ctx, unsigned part, unsigned parts)
+{
+    job *j = ctx;
+    j->seen[part] = j->round;
+    j->runs[part]++;
+    size_t b = pose__part_begin(ITEMS, part, parts), e = pose__part_begin(ITEMS, part + 1, parts);
+    for (size_t i = b; i < e; i++)
+        j->data[i] += (int)i;
+}
+
+static void test_pool_runs_every_part_once(void **unused)
+{
+    (void)unused;
+    for (unsigned threads = 1; threads <= 4; threads++) {
+        pose__pool *pool = aligned_alloc(64, (pose__pool_size(threads) + 63) & ~(size_t)63);
+        assert_non_null(pool);
+        assert_int_equal(pose__pool_init(pool, threads), 0);
+        assert_int_equal(pose__pool_threads(pool), threads);
+        job *j = calloc(1, sizeof *j);
+        for (int r = 1; r <= 200; r++) {
+            j->round = r;
+            pose__pool_run(pool, task, j);
+            for (unsigned p = 0; p < threads; p++)
+                assert_int_equal(j->seen[p], r);
+        }
+        for (unsigned p = 0; p < threads; p++)
+            assert_int_equal(j->runs[p], 200);
+        for (size_t i = 0; i < ITEMS; i++)
+            assert_int_equal(j->data[i], 200 * (int)i); /* each item by exactly one part */
+        free(j);
+        pose__pool_destroy(pool);
+        free(pool);
+    }
+}
+
+static void test_part_ranges_cover(void **unused)
+{
+    (void)unused;
+    for (unsigned parts = 1; parts <= 7; parts++)
+        for (size_t n = 0; n < 50; n++) {
+            assert_int_equal(pose__part_begin(n, 0, parts), 0);
+            assert_int_equal(pose__part_begin(n, parts, parts), n);
+            for (unsigned p = 0; p < parts; p++)
+                assert_true(pose__part_begin(n, p, parts) <= pose__part_begin(n, p + 1, parts));
+        }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_part_ranges_cover),
+        cmocka_unit_test(test_pool_runs_every_part_once),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
