@@ -14,6 +14,9 @@
 
 typedef struct ex_motion ex_motion;
 
+/** 1 when this build can drive from sources (the bridge is linked in), else 0. */
+int ex_motion_available(void);
+
 /** Open `source` with mapping `map` (NULL: the bridge's default for the source) for `rig`. */
 int ex_motion_open(const char *source, const char *map, const pose_rig *rig, ex_motion **out, char *err,
                    size_t err_size);

@@ -5,6 +5,11 @@
 
 #include <stdio.h>
 
+int ex_motion_available(void)
+{
+    return 0;
+}
+
 int ex_motion_open(const char *source, const char *map, const pose_rig *rig, ex_motion **out, char *err,
                    size_t err_size)
 {

@@ -92,10 +92,16 @@ void ex_scene_bounds(const ex_scene *sc, int posed, float bmin[3], float bmax[3]
                 ex_grow(bmin, bmax, p, n);
         }
     }
-    if (!(bmin[0] <= bmax[0])) {
+    /* The tet mesh is what is drawn in weight mode, and all there is without tissues. */
+    if (!(bmin[0] <= bmax[0]) || sc->weight_joint >= 0) {
         pose_tet_info tet;
-        if (pose_rig_tet_info(sc->rig, &tet) == POSE_OK)
+        if (pose_rig_tet_info(sc->rig, &tet) == POSE_OK) {
             ex_grow(bmin, bmax, tet.rest_positions, tet.vertex_count);
+            size_t n;
+            const float *p = posed ? pose_tet_positions(sc->state, &n) : NULL;
+            if (p)
+                ex_grow(bmin, bmax, p, n);
+        }
     }
     if (!(bmin[0] <= bmax[0]))
         for (int a = 0; a < 3; a++) {

@@ -25,7 +25,7 @@ typedef struct options {
     const char *rig, *output, *source, *map, *caption, *weights;
     const char *poses[MAX_POSES];
     int pose_count;
-    int width, height, supersample, turntable, compare, json, threads;
+    int width, height, supersample, turntable, compare, json, threads, list_joints;
     int method; /* -1: CoR when the rig has it, else LBS */
     long *frames;
     size_t frame_count;
@@ -71,7 +71,11 @@ static void usage(FILE *f)
           "  -o, --output PATH            PNG file for one image (default pose.png), or a folder\n"
           "                               for --frames / --turntable (default render/)\n"
           "  --json                       print a JSON summary on stdout\n"
+          "  --list-joints                print the rig's joints (name, parent, limits) and exit\n"
           "  -h, --help                   this text\n",
+          f);
+    fputs(ex_motion_available() ? "Sources: through the input bridge (BVH, ASF/AMC, HID and CAN recordings).\n"
+                                : "Sources: none, built without the bridge (--source is refused).\n",
           f);
 }
 
@@ -112,6 +116,9 @@ static int parse_args(int argc, char **argv, options *o, char *err, size_t err_s
             exit(0);
         } else if (!strcmp(a, "--json")) {
             o->json = 1;
+            takes = 0;
+        } else if (!strcmp(a, "--list-joints")) {
+            o->list_joints = 1;
             takes = 0;
         } else if (!strcmp(a, "--compare")) {
             o->compare = 1;
@@ -348,6 +355,20 @@ static int run(const options *o, summary *s, char *err, size_t err_size)
 
     if (ex_scene_open(&sc, o->rig, err, err_size) < 0)
         return -1;
+    if (o->list_joints) {
+        for (size_t j = 0; j < pose_rig_joint_count(sc.rig); j++) {
+            pose_joint_info ji;
+            if (pose_rig_joint_info(sc.rig, (int)j, &ji) < 0)
+                continue;
+            printf("%s parent=%d", ji.name, ji.parent);
+            for (int a = 0; a < 3; a++)
+                if (ji.limit_flags & (1u << a))
+                    printf(" %c=[%g,%g]", "xyz"[a], ji.limit_min_deg[a], ji.limit_max_deg[a]);
+            printf("\n");
+        }
+        ex_scene_close(&sc);
+        return 0;
+    }
     if (o->threads)
         pose_set_threads(sc.state, o->threads);
     sc.skin_mode = o->skin;
@@ -442,10 +463,9 @@ static int run(const options *o, summary *s, char *err, size_t err_size)
             int scale = o->width >= 480 ? 3 : 2;
             ex_image_text(&img, (img.width - ex_font_text_width(label) * scale) / 2,
                           img.height - (EX_FONT_H + 4) * scale, scale, text_col, label);
-            if (m == 0)
-                caption(&img, o->caption);
             ex_image_blit(&panel, &img, m * o->width, 0);
         }
+        caption(&panel, o->caption);
         if (emit(s, &panel, out, -1, "LBS|DQS|CoR", 1e3 * (ex_now() - t0), apply, err, err_size) < 0)
             goto done;
     } else if (motion) {

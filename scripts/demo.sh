@@ -1,0 +1,170 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
+#
+# The main job: from a fresh checkout to pictures of a posed patient.
+#   1. installs the Debian packages (scripts/install-deps.sh; needs root)
+#   2. configures and builds pose in Release into build/
+#   3. bakes the bundled anatomy (data/anatomy) into a rig at reduced
+#      resolution with pose-bake
+#   4. replays a bundled CMU walk (data/mocap/cmu-bvh/131_01.bvh) onto it
+#      through the input bridge (pose-bridge)
+#   5. renders frames to PNG (pose-render, off-screen) into out/demo/
+# With --view and a display, it then opens pose-view on the same rig and clip.
+# Where a stage is missing from this checkout, the script says so and shows
+# the same chain on the synthetic bar instead; it never pretends.
+set -euo pipefail
+
+root=$(cd "$(dirname "$0")/.." && pwd)
+out="$root/out/demo"
+build="$root/build"
+jobs=$(nproc 2>/dev/null || echo 2)
+view=0
+deps=1
+clip="$root/data/mocap/cmu-bvh/131_01.bvh"
+
+usage() {
+    cat <<EOF
+usage: bash scripts/demo.sh [--view] [--no-deps] [--out DIR] [--jobs N]
+Install dependencies, build, bake the bundled anatomy, replay a CMU walk
+onto it and render PNG frames (headless). Results go to out/demo/.
+  --view      afterwards open pose-view on the result (needs \$DISPLAY)
+  --no-deps   skip scripts/install-deps.sh (packages already present)
+  --out DIR   where to write the rig, images and logs (default out/demo)
+  --jobs N    parallel build jobs (default: number of cores)
+EOF
+}
+
+while [ $# -gt 0 ]; do
+    case "$1" in
+    --view) view=1 ;;
+    --no-deps) deps=0 ;;
+    --out) out=$(mkdir -p "$2" && cd "$2" && pwd); shift ;;
+    --jobs) jobs=$2; shift ;;
+    -h | --help) usage; exit 0 ;;
+    *) echo "demo: unknown option '$1'" >&2; usage >&2; exit 2 ;;
+    esac
+    shift
+done
+
+t0=$(date +%s)
+stage_t=$t0
+stage() { # <title>: prints the time the previous stage took
+    local now
+    now=$(date +%s)
+    [ "$stage_t" -ne "$t0" ] && printf '   (%ds)\n' $((now - stage_t))
+    stage_t=$now
+    printf '\n== %s\n' "$*"
+}
+die() { echo "demo: $*" >&2; exit 1; }
+tool() { # <name>: path of a built tool, or nothing
+    find "$build" -maxdepth 3 -type f -name "$1" -perm -u+x 2>/dev/null | head -n 1
+}
+
+mkdir -p "$out"
+log="$out/demo.log"
+: >"$log"
+
+stage "1/5 dependencies"
+if [ $deps -eq 1 ]; then
+    if [ "$(id -u)" -eq 0 ]; then
+        bash "$root/scripts/install-deps.sh"
+    elif bash "$root/scripts/install-deps.sh" >/dev/null 2>&1; then
+        echo "all packages present"
+    else
+        die "packages are missing and this is not root: run 'sudo bash scripts/install-deps.sh' first"
+    fi
+else
+    echo "skipped (--no-deps)"
+fi
+
+stage "2/5 build (Release, $build)"
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >>"$log" 2>&1 ||
+    die "cmake configure failed; see $log"
+# Only what the demo runs: the test suite is scripts/test.sh's job.
+targets=()
+available=$(cmake --build "$build" --target help 2>/dev/null)
+for t in pose-synth pose-bake pose-bridge pose-render pose-export pose-view; do
+    grep -q "^$t:" <<<"$available" && targets+=("$t")
+done
+grep -q "^pose-render:" <<<"$available" ||
+    die "pose-render is not configured (needs libosmesa6-dev and libpng-dev); see $log"
+cmake --build "$build" -j "$jobs" --target "${targets[@]}" >>"$log" 2>&1 || die "build failed; see $log"
+echo "built: ${targets[*]}"
+
+render=$(tool pose-render)
+export_tool=$(tool pose-export)
+bake=$(tool pose-bake)
+bridge=$(tool pose-bridge)
+synth=$(tool pose-synth)
+pose_view=$(tool pose-view)
+
+frames_dir="$out/frames"
+rm -rf "$frames_dir"
+mkdir -p "$frames_dir"
+
+# The full chain needs pose-bake and the bridge's replay; both are detected, not assumed.
+have_bake=0
+[ -n "$bake" ] && "$bake" --help >/dev/null 2>&1 && have_bake=1
+have_replay=0
+[ -n "$bridge" ] && "$bridge" replay --help >/dev/null 2>&1 && have_replay=1
+have_source=0
+"$render" --help | grep -q "built without the bridge" || have_source=1
+
+if [ $have_bake -eq 1 ]; then
+    stage "3/5 bake the bundled anatomy (reduced resolution)"
+    rig="$out/body.rig"
+    "$bake" --template "$root/preprocess/templates/full_body.json" --anatomy "$root/data/anatomy" \
+        --resolution demo -o "$rig" 2>&1 | tee -a "$log" || die "pose-bake failed; see $log"
+    map="$root/bridge/maps/cmu_to_full_body.json"
+else
+    stage "3/5 bake: pose-bake is not in this build yet - using the synthetic four-bone bar instead"
+    [ -n "$synth" ] || die "neither pose-bake nor pose-synth was built; see $log"
+    rig="$out/bar.rig"
+    "$synth" bar -o "$rig" | tee -a "$log"
+    map="$root/bridge/maps/cmu_to_bar.json"
+fi
+
+frames=()
+if [ $have_replay -eq 1 ] && [ $have_source -eq 1 ] && [ -f "$map" ]; then
+    stage "4/5 replay $(basename "$clip") through the bridge"
+    "$bridge" replay "$clip" --rig "$rig" --map "$map" --speed 0 2>&1 | tail -n 5 | tee -a "$log" ||
+        die "pose-bridge replay failed; see $log"
+    stage "5/5 render frames (OSMesa, off-screen)"
+    "$render" "$rig" --source "$clip" --map "$map" --frames 1-361:40 --caption "CMU 131_01 walk" \
+        -o "$frames_dir" | tee -a "$log"
+else
+    stage "4/5 replay: the bridge's mocap replay is not in this build yet - posing by hand instead"
+    joint=$("$render" "$rig" --list-joints | awk 'NR == 3 {print $1}')
+    [ -n "$joint" ] || die "could not list the rig's joints"
+    echo "joint $joint: a bend of 0, 30, 60, 90 deg; LBS | DQS | CoR panels of a 90 deg bend and a 135 deg twist"
+    stage "5/5 render frames (OSMesa, off-screen)"
+    for a in 0 30 60 90; do
+        "$render" "$rig" --pose "$joint=0,$a,0" --caption "bend $a deg" \
+            -o "$frames_dir/bend_$(printf %03d "$a").png" | tee -a "$log"
+    done
+    "$render" "$rig" --compare --pose "$joint=0,90,0" --caption "bend 90 deg at $joint" \
+        -o "$out/compare_bend.png" | tee -a "$log"
+    "$render" "$rig" --compare --pose "$joint=135,0,0" --caption "twist 135 deg at $joint" \
+        -o "$out/compare_twist.png" | tee -a "$log"
+    "$render" "$rig" --weights "$joint" --caption "weight of $joint" -o "$out/weights.png" | tee -a "$log"
+    [ -n "$export_tool" ] && "$export_tool" "$rig" --pose "$joint=0,90,0" --obj "$out/bent.obj" \
+        --vtu "$out/bent.vtu" | tee -a "$log"
+fi
+
+now=$(date +%s)
+printf '   (%ds)\n' $((now - stage_t))
+echo
+echo "demo: done in $((now - t0)) s. Images and files are in: $out"
+ls -1 "$out" "$frames_dir" | sed 's/^/  /'
+
+if [ $view -eq 1 ]; then
+    if [ -z "${DISPLAY:-}${WAYLAND_DISPLAY:-}" ]; then
+        echo "demo: --view asked, but there is no display (DISPLAY is unset); the PNGs above are the result"
+    elif [ -z "$pose_view" ]; then
+        echo "demo: --view asked, but pose-view was not built (needs libglfw3-dev)"
+    elif [ $have_replay -eq 1 ] && [ $have_source -eq 1 ] && [ -f "$map" ]; then
+        "$pose_view" "$rig" --source "$clip" --map "$map"
+    else
+        "$pose_view" "$rig"
+    fi
+fi

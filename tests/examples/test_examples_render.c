@@ -1,0 +1,418 @@
+/* SPDX-License-Identifier: Apache-2.0
+ *
+ * The example tools as a user runs them: pose-render under OSMesa makes
+ * images that are not blank, whose silhouette follows the pose, and whose
+ * LBS and CoR pictures of a strong twist differ where the paper says (LBS
+ * collapses the bar at the joint); bad input gives a clear message and a
+ * non-zero exit; pose-view without a display refuses plainly; the
+ * quickstart runs; pose-export writes files other tools can read.
+ *
+ * argv: pose-render pose-synth pose-view|- pose-export pose-quickstart
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <cmocka.h>
+#include <png.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+
+static const char *render_bin, *synth_bin, *view_bin, *export_bin, *quickstart_bin;
+static char tmp[2048], bar[2300];
+
+/* Run a shell command; its stdout+stderr go to `log`. Returns the exit status. */
+static int run(const char *log, const char *fmt, ...)
+{
+    char cmd[8192];
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(cmd, sizeof cmd, fmt, ap);
+    va_end(ap);
+    assert_true(n > 0 && (size_t)n < sizeof cmd - 64);
+    snprintf(cmd + n, sizeof cmd - (size_t)n, " >'%s' 2>&1", log);
+    int st = system(cmd);
+    assert_true(st != -1 && WIFEXITED(st));
+    return WEXITSTATUS(st);
+}
+
+static char *slurp(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    static char buf[1 << 16];
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = '\0';
+    return buf;
+}
+
+typedef struct image {
+    png_uint_32 w, h;
+    uint8_t *px; /* RGBA */
+} image;
+
+static image load_png(const char *path)
+{
+    png_image pi;
+    memset(&pi, 0, sizeof pi);
+    pi.version = PNG_IMAGE_VERSION;
+    assert_true(png_image_begin_read_from_file(&pi, path));
+    pi.format = PNG_FORMAT_RGBA;
+    image im = {pi.width, pi.height, malloc(PNG_IMAGE_SIZE(pi))};
+    assert_non_null(im.px);
+    assert_true(png_image_finish_read(&pi, NULL, im.px, 0, NULL));
+    return im;
+}
+
+/* Foreground mask: pixels that differ from the corner (background) colour. */
+static int is_fg(const image *im, size_t x, size_t y)
+{
+    const uint8_t *bg = im->px, *p = im->px + 4 * (y * im->w + x);
+    return abs(p[0] - bg[0]) + abs(p[1] - bg[1]) + abs(p[2] - bg[2]) > 24;
+}
+
+static double coverage(const image *im)
+{
+    size_t hit = 0;
+    for (size_t y = 0; y < im->h; y++)
+        for (size_t x = 0; x < im->w; x++)
+            hit += (size_t)is_fg(im, x, y);
+    return (double)hit / (double)(im->w * im->h);
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    const char *t = getenv("POSE_TEST_TMP");
+    snprintf(tmp, sizeof tmp, "%s", t ? t : "/tmp");
+    snprintf(bar, sizeof bar, "%s/bar.rig", tmp);
+    char log[2400];
+    snprintf(log, sizeof log, "%s/synth.log", tmp);
+    return run(log, "'%s' bar -o '%s'", synth_bin, bar) == 0 ? 0 : -1;
+}
+
+/* ---------------------------------------------------------- bad input first */
+
+static void test_missing_rig(void **state)
+{
+    (void)state;
+    char log[2400];
+    snprintf(log, sizeof log, "%s/missing.log", tmp);
+    assert_int_not_equal(run(log, "'%s' '%s/no_such.rig' -o '%s/x.png'", render_bin, tmp, tmp), 0);
+    const char *msg = slurp(log);
+    assert_non_null(strstr(msg, "pose-render: cannot load rig"));
+    assert_non_null(strstr(msg, "no_such.rig"));
+    assert_int_not_equal(run(log, "'%s' '%s/no_such.rig' --obj '%s/x.obj'", export_bin, tmp, tmp), 0);
+    assert_non_null(strstr(slurp(log), "no_such.rig"));
+}
+
+static void test_not_a_rig(void **state)
+{
+    (void)state;
+    char log[2400], path[2400];
+    snprintf(path, sizeof path, "%s/garbage.rig", tmp);
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    fputs("this is not a rig file, it is text of some length to pass any size check ...", f);
+    fclose(f);
+    snprintf(log, sizeof log, "%s/garbage.log", tmp);
+    assert_int_equal(run(log, "'%s' '%s' -o '%s/x.png'", render_bin, path, tmp), 1);
+    assert_non_null(strstr(slurp(log), "garbage.rig"));
+}
+
+static void test_bad_options(void **state)
+{
+    (void)state;
+    char log[2400];
+    snprintf(log, sizeof log, "%s/opts.log", tmp);
+    assert_int_equal(run(log, "'%s'", render_bin), 2);
+    assert_non_null(strstr(slurp(log), "no rig given"));
+    assert_int_equal(run(log, "'%s' '%s' --size 10x10", render_bin, bar), 2);
+    assert_non_null(strstr(slurp(log), "--size"));
+    assert_int_equal(run(log, "'%s' '%s' --method foo", render_bin, bar), 2);
+    assert_int_equal(run(log, "'%s' '%s' --frames 0,1", render_bin, bar), 2);
+    assert_non_null(strstr(slurp(log), "--frames needs --source"));
+    assert_int_equal(run(log, "'%s' '%s' --pose nosuchjoint=0,0,0 -o '%s/x.png'", render_bin, bar, tmp), 1);
+    assert_non_null(strstr(slurp(log), "no joint 'nosuchjoint'"));
+    assert_int_equal(run(log, "'%s' '%s' --pose bone1=1,2 -o '%s/x.png'", render_bin, bar, tmp), 1);
+    assert_non_null(strstr(slurp(log), "three angles"));
+    assert_int_equal(run(log, "'%s' '%s' -o '%s/no/such/dir/x.png'", render_bin, bar, tmp), 1);
+    assert_non_null(strstr(slurp(log), "cannot create"));
+}
+
+static void test_broken_source(void **state)
+{
+    (void)state;
+    char log[2400], path[2400];
+    snprintf(path, sizeof path, "%s/broken.bvh", tmp);
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    fputs("HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 6 Xposition Yposition", f); /* truncated */
+    fclose(f);
+    snprintf(log, sizeof log, "%s/broken.log", tmp);
+    assert_int_equal(run(log, "'%s' '%s' --source '%s' --frames 0 -o '%s/frames'", render_bin, bar, path, tmp), 1);
+    assert_non_null(strstr(slurp(log), "broken.bvh"));
+    assert_int_equal(
+        run(log, "'%s' '%s' --source '%s/none.bvh' --frames 0 -o '%s/frames'", render_bin, bar, tmp, tmp), 1);
+    assert_non_null(strstr(slurp(log), "none.bvh"));
+}
+
+static void test_view_without_display(void **state)
+{
+    (void)state;
+    if (!strcmp(view_bin, "-"))
+        skip(); /* pose-view not built (no GLFW) */
+    char log[2400];
+    snprintf(log, sizeof log, "%s/view.log", tmp);
+    assert_int_equal(run(log, "env -u DISPLAY -u WAYLAND_DISPLAY '%s' '%s'", view_bin, bar), 1);
+    assert_non_null(strstr(slurp(log), "no display"));
+    assert_int_not_equal(run(log, "env -u DISPLAY -u WAYLAND_DISPLAY '%s' '%s/none.rig'", view_bin, tmp), 0);
+    assert_non_null(strstr(slurp(log), "none.rig"));
+}
+
+/* ---------------------------------------------------------------- images */
+
+static void test_rest_image_not_blank(void **state)
+{
+    (void)state;
+    char log[2400], png[2400];
+    snprintf(png, sizeof png, "%s/rest.png", tmp);
+    snprintf(log, sizeof log, "%s/rest.log", tmp);
+    assert_int_equal(run(log, "'%s' '%s' --size 320x240 -o '%s' --json", render_bin, bar, png), 0);
+    assert_non_null(strstr(slurp(log), "\"ok\": true"));
+    image im = load_png(png);
+    assert_int_equal(im.w, 320);
+    assert_int_equal(im.h, 240);
+    double c = coverage(&im);
+    printf("rest image coverage %.3f\n", c);
+    assert_true(c > 0.05 && c < 0.9); /* the model is there and framed, not clipped */
+    /* Shaded, not flat: many distinct foreground intensities. */
+    int seen[256] = {0}, distinct = 0;
+    for (size_t i = 0; i < (size_t)im.w * im.h; i++)
+        if (is_fg(&im, i % im.w, i / im.w))
+            seen[im.px[4 * i + 1]] = 1;
+    for (int i = 0; i < 256; i++)
+        distinct += seen[i];
+    assert_true(distinct > 20);
+    free(im.px);
+}
+
+/* A scripted pose sequence: the silhouette must move, and by more for a larger bend. */
+static void test_silhouette_follows_pose(void **state)
+{
+    (void)state;
+    char log[2400];
+    snprintf(log, sizeof log, "%s/seq.log", tmp);
+    image im[3];
+    const int angles[3] = {0, 30, 80};
+    for (int i = 0; i < 3; i++) {
+        char png[2400];
+        snprintf(png, sizeof png, "%s/seq_%d.png", tmp, i);
+        /* Fixed camera (side view of the bar), so images are comparable. */
+        assert_int_equal(run(log,
+                             "'%s' '%s' --size 320x240 --azimuth 90 --elevation 0 --zoom 0.8 "
+                             "--pose bone2=0,%d,0 -o '%s'",
+                             render_bin, bar, angles[i], png),
+                         0);
+        im[i] = load_png(png);
+    }
+    size_t diff[2] = {0, 0};
+    for (int k = 0; k < 2; k++)
+        for (size_t y = 0; y < im[0].h; y++)
+            for (size_t x = 0; x < im[0].w; x++)
+                diff[k] += (size_t)(is_fg(&im[0], x, y) != is_fg(&im[k + 1], x, y));
+    printf("silhouette pixels changed: %zu (30 deg), %zu (80 deg)\n", diff[0], diff[1]);
+    assert_true(diff[0] > 200);
+    assert_true(diff[1] > diff[0] + 200);
+    for (int i = 0; i < 3; i++)
+        free(im[i].px);
+}
+
+/*
+ * Candy wrapper: a 135 degree twist of the bar about its axis makes LBS
+ * collapse the cross-section at the joint; CoR keeps it. Seen from the side,
+ * the silhouette's height at the joint's column shrinks under LBS only.
+ */
+static double waist_ratio(const image *im)
+{
+    /* Column heights of the foreground; the waist is the thinnest column in
+     * the middle half relative to the median column height. */
+    size_t *hgt = calloc(im->w, sizeof *hgt), first = im->w, last = 0;
+    for (size_t x = 0; x < im->w; x++) {
+        for (size_t y = 0; y < im->h; y++)
+            hgt[x] += (size_t)is_fg(im, x, y);
+        if (hgt[x] > 2) {
+            if (first == im->w)
+                first = x;
+            last = x;
+        }
+    }
+    assert_true(last > first + 20);
+    size_t span = last - first, lo = first + span / 4, hi = last - span / 4, minh = im->h;
+    for (size_t x = lo; x <= hi; x++)
+        minh = hgt[x] < minh ? hgt[x] : minh;
+    size_t q1 = hgt[first + span / 8], q3 = hgt[last - span / 8]; /* away from the joint */
+    free(hgt);
+    return (double)minh / (0.5 * (double)(q1 + q3));
+}
+
+static void test_lbs_vs_cor_twist(void **state)
+{
+    (void)state;
+    char log[2400];
+    snprintf(log, sizeof log, "%s/twist.log", tmp);
+    static const char *methods[2] = {"lbs", "cor"};
+    double ratio[2];
+    for (int m = 0; m < 2; m++) {
+        char png[2400];
+        snprintf(png, sizeof png, "%s/twist_%s.png", tmp, methods[m]);
+        assert_int_equal(run(log,
+                             "'%s' '%s' --size 480x240 --azimuth 90 --elevation 0 --skin opaque "
+                             "--pose bone2=135,0,0 --method %s -o '%s'",
+                             render_bin, bar, methods[m], png),
+                         0);
+        image im = load_png(png);
+        ratio[m] = waist_ratio(&im);
+        free(im.px);
+    }
+    printf("twist 135 deg, silhouette waist / normal height: LBS %.2f, CoR %.2f\n", ratio[0], ratio[1]);
+    assert_true(ratio[1] > 0.85); /* CoR keeps the cross-section */
+    assert_true(ratio[0] < 0.75); /* LBS collapses it */
+    assert_true(ratio[0] < ratio[1] - 0.15);
+}
+
+static void test_compare_panel(void **state)
+{
+    (void)state;
+    char log[2400], png[2400];
+    snprintf(png, sizeof png, "%s/panel.png", tmp);
+    snprintf(log, sizeof log, "%s/panel.log", tmp);
+    assert_int_equal(run(log, "'%s' '%s' --size 200x200 --compare --pose bone2=0,90,0 --caption test -o '%s'",
+                         render_bin, bar, png),
+                     0);
+    image im = load_png(png);
+    assert_int_equal(im.w, 600);
+    assert_int_equal(im.h, 200);
+    /* Every third holds a picture. */
+    for (size_t p = 0; p < 3; p++) {
+        size_t hit = 0;
+        for (size_t y = 0; y < im.h; y++)
+            for (size_t x = p * 200; x < (p + 1) * 200; x++)
+                hit += (size_t)is_fg(&im, x, y);
+        assert_true(hit > 2000);
+    }
+    free(im.px);
+}
+
+static void test_turntable(void **state)
+{
+    (void)state;
+    char log[2400], dir[2400], png[2500];
+    snprintf(dir, sizeof dir, "%s/turn", tmp);
+    snprintf(log, sizeof log, "%s/turn.log", tmp);
+    assert_int_equal(run(log, "'%s' '%s' --size 64x64 --turntable 4 -o '%s'", render_bin, bar, dir), 0);
+    for (int i = 0; i < 4; i++) {
+        snprintf(png, sizeof png, "%s/turn_%03d.png", dir, i);
+        image im = load_png(png);
+        assert_true(coverage(&im) > 0.02);
+        free(im.px);
+    }
+}
+
+/* ------------------------------------------------------- quickstart, export */
+
+static void test_quickstart(void **state)
+{
+    (void)state;
+    char log[2400];
+    snprintf(log, sizeof log, "%s/quick.log", tmp);
+    assert_int_equal(run(log, "'%s' '%s' bone2", quickstart_bin, bar), 0);
+    const char *out = slurp(log);
+    const char *moved = strstr(out, "moved up to ");
+    assert_non_null(moved);
+    double d = atof(moved + strlen("moved up to "));
+    printf("%s", out);
+    assert_true(d > 0.1); /* a 60 degree bend at the third of four unit bones moves the tip far */
+    assert_int_equal(run(log, "'%s' '%s/none.rig'", quickstart_bin, tmp), 1);
+    assert_non_null(strstr(slurp(log), "none.rig"));
+}
+
+static void test_export(void **state)
+{
+    (void)state;
+    char log[2400], obj[2400], vtu[2400], ply[2400];
+    snprintf(log, sizeof log, "%s/export.log", tmp);
+    snprintf(obj, sizeof obj, "%s/bent.obj", tmp);
+    snprintf(vtu, sizeof vtu, "%s/bent.vtu", tmp);
+    snprintf(ply, sizeof ply, "%s/ply", tmp);
+    assert_int_equal(run(log, "'%s' '%s' --pose bone2=0,90,0 --obj '%s' --ply '%s' --vtu '%s' --weights bone2",
+                         export_bin, bar, obj, ply, vtu),
+                     0);
+    /* OBJ: as many v lines as the rig has tissue vertices, faces index within range. */
+    FILE *f = fopen(obj, "r");
+    assert_non_null(f);
+    char line[512];
+    size_t v = 0, faces = 0, objects = 0, bad = 0;
+    while (fgets(line, sizeof line, f)) {
+        if (!strncmp(line, "v ", 2))
+            v++;
+        else if (!strncmp(line, "o ", 2))
+            objects++;
+        else if (!strncmp(line, "f ", 2)) {
+            faces++;
+            unsigned long a, b, c, na, nb, nc;
+            if (sscanf(line, "f %lu//%lu %lu//%lu %lu//%lu", &a, &na, &b, &nb, &c, &nc) != 6 || a < 1 || a > v ||
+                b < 1 || b > v || c < 1 || c > v)
+                bad++;
+        }
+    }
+    fclose(f);
+    printf("OBJ: %zu objects, %zu vertices, %zu faces\n", objects, v, faces);
+    assert_true(objects >= 2 && v > 100 && faces > 100);
+    assert_int_equal(bad, 0);
+    /* VTU: well-formed header, counts that match the body. */
+    f = fopen(vtu, "r");
+    assert_non_null(f);
+    size_t np = 0, nc = 0;
+    int found = 0;
+    while (fgets(line, sizeof line, f))
+        if (sscanf(line, "<Piece NumberOfPoints=\"%zu\" NumberOfCells=\"%zu\"", &np, &nc) == 2)
+            found = 1;
+    fclose(f);
+    assert_true(found && np > 100 && nc > 100);
+    assert_memory_equal(slurp(vtu), "<?xml", 5);
+    /* One binary PLY per tissue. */
+    assert_int_equal(run(log, "ls '%s'/*.ply | wc -l | grep -qv '^0$'", ply), 0);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 6) {
+        fprintf(stderr, "usage: %s pose-render pose-synth pose-view|- pose-export pose-quickstart\n", argv[0]);
+        return 2;
+    }
+    render_bin = argv[1];
+    synth_bin = argv[2];
+    view_bin = argv[3];
+    export_bin = argv[4];
+    quickstart_bin = argv[5];
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_missing_rig),
+        cmocka_unit_test(test_not_a_rig),
+        cmocka_unit_test(test_bad_options),
+        cmocka_unit_test(test_broken_source),
+        cmocka_unit_test(test_view_without_display),
+        cmocka_unit_test(test_rest_image_not_blank),
+        cmocka_unit_test(test_silhouette_follows_pose),
+        cmocka_unit_test(test_lbs_vs_cor_twist),
+        cmocka_unit_test(test_compare_panel),
+        cmocka_unit_test(test_turntable),
+        cmocka_unit_test(test_quickstart),
+        cmocka_unit_test(test_export),
+    };
+    return cmocka_run_group_tests(tests, setup, NULL);
+}
