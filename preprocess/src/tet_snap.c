@@ -1,0 +1,356 @@
+/* SPDX-License-Identifier: Apache-2.0
+ *
+ * Boundary snapping for the lattice mesher: a bucket grid of the surface
+ * triangles, a ray cast along each boundary vertex's staircase normal (so
+ * corners go to corners), the closest point as fallback, and a volume check
+ * on the incident tets that halves or drops a move rather than invert.
+ */
+#include "tet_snap.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* A move may not push an incident tet below this shape quality (or below
+ * its own, if already worse): about 0.2 keeps dihedral angles above ~10 deg. */
+#ifndef PP_SNAP_MIN_SHAPE
+#define PP_SNAP_MIN_SHAPE 0.2
+#endif
+
+typedef struct buckets {
+    double o[3], b;   /* origin, bucket edge */
+    int n[3];
+    size_t *start;    /* n0*n1*n2 + 1 */
+    uint32_t *tri;
+} buckets;
+
+static void bucket_range(const buckets *g, const double lo[3], const double hi[3], int a[3],
+                         int z[3])
+{
+    for (int k = 0; k < 3; k++) {
+        double l = floor((lo[k] - g->o[k]) / g->b), h = floor((hi[k] - g->o[k]) / g->b);
+        a[k] = l < 0 ? 0 : l >= g->n[k] ? g->n[k] - 1 : (int)l;
+        z[k] = h < 0 ? 0 : h >= g->n[k] ? g->n[k] - 1 : (int)h;
+    }
+}
+
+static void tri_bounds(const pp_mesh *m, size_t t, double lo[3], double hi[3])
+{
+    for (int k = 0; k < 3; k++) {
+        lo[k] = INFINITY;
+        hi[k] = -INFINITY;
+    }
+    for (int c = 0; c < 3; c++)
+        for (int k = 0; k < 3; k++) {
+            double v = m->positions[3 * (size_t)m->triangles[3 * t + c] + k];
+            lo[k] = fmin(lo[k], v);
+            hi[k] = fmax(hi[k], v);
+        }
+}
+
+static pose_status buckets_build(const pp_mesh *m, double b, buckets *g)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < m->vertex_count; i++)
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fmin(lo[k], m->positions[3 * i + k]);
+            hi[k] = fmax(hi[k], m->positions[3 * i + k]);
+        }
+    /* Keep the grid to a few million buckets whatever the reach. */
+    for (;;) {
+        double cnt = 1;
+        for (int k = 0; k < 3; k++)
+            cnt *= floor((hi[k] - lo[k]) / b) + 1;
+        if (cnt < 4e6)
+            break;
+        b *= 1.5;
+    }
+    g->b = b;
+    size_t total = 1;
+    for (int k = 0; k < 3; k++) {
+        g->o[k] = lo[k];
+        g->n[k] = (int)floor((hi[k] - lo[k]) / b) + 1;
+        total *= (size_t)g->n[k];
+    }
+    g->start = calloc(total + 1, sizeof *g->start);
+    if (!g->start)
+        return POSE_ERR_OUT_OF_MEMORY;
+    int a[3], z[3];
+    double tl[3], th[3];
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t t = 0; t < m->triangle_count; t++) {
+            tri_bounds(m, t, tl, th);
+            bucket_range(g, tl, th, a, z);
+            for (int k = a[2]; k <= z[2]; k++)
+                for (int j = a[1]; j <= z[1]; j++)
+                    for (int i = a[0]; i <= z[0]; i++) {
+                        size_t c = (size_t)i + (size_t)g->n[0] * ((size_t)j + (size_t)g->n[1] * k);
+                        if (pass == 0)
+                            g->start[c + 1]++;
+                        else
+                            g->tri[g->start[c]++] = (uint32_t)t;
+                    }
+        }
+        if (pass == 0) {
+            for (size_t c = 0; c < total; c++)
+                g->start[c + 1] += g->start[c];
+            g->tri = malloc((g->start[total] ? g->start[total] : 1) * sizeof *g->tri);
+            if (!g->tri)
+                return POSE_ERR_OUT_OF_MEMORY;
+        }
+    }
+    /* The fill pass advanced each start to the next bucket's: shift back. */
+    memmove(g->start + 1, g->start, total * sizeof *g->start);
+    g->start[0] = 0;
+    return POSE_OK;
+}
+
+static void sub3(const double *a, const double *b, double *r)
+{
+    r[0] = a[0] - b[0];
+    r[1] = a[1] - b[1];
+    r[2] = a[2] - b[2];
+}
+static double dot3(const double *a, const double *b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+static void cross3(const double *a, const double *b, double *r)
+{
+    r[0] = a[1] * b[2] - a[2] * b[1];
+    r[1] = a[2] * b[0] - a[0] * b[2];
+    r[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static void tri_points(const pp_mesh *m, uint32_t t, double v[3][3])
+{
+    for (int c = 0; c < 3; c++)
+        for (int k = 0; k < 3; k++)
+            v[c][k] = m->positions[3 * (size_t)m->triangles[3 * (size_t)t + c] + k];
+}
+
+/* Line p + s d (d unit) against a triangle (Moller-Trumbore); s any sign. */
+static int ray_tri(const double p[3], const double d[3], double v[3][3], double *s)
+{
+    double e1[3], e2[3], q[3], tv[3], r[3];
+    sub3(v[1], v[0], e1);
+    sub3(v[2], v[0], e2);
+    cross3(d, e2, q);
+    double det = dot3(e1, q);
+    if (fabs(det) < 1e-30)
+        return 0;
+    double inv = 1.0 / det;
+    sub3(p, v[0], tv);
+    double u = dot3(tv, q) * inv;
+    if (u < -1e-9 || u > 1.0 + 1e-9)
+        return 0;
+    cross3(tv, e1, r);
+    double w = dot3(d, r) * inv;
+    if (w < -1e-9 || u + w > 1.0 + 1e-9)
+        return 0;
+    *s = dot3(e2, r) * inv;
+    return 1;
+}
+
+/* Closest point on triangle v to p (Ericson, Real-Time Collision Detection 5.1.5). */
+static void closest_on_tri(const double p[3], double v[3][3], double out[3])
+{
+    double ab[3], ac[3], ap[3];
+    sub3(v[1], v[0], ab);
+    sub3(v[2], v[0], ac);
+    sub3(p, v[0], ap);
+    double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
+    if (d1 <= 0 && d2 <= 0) {
+        memcpy(out, v[0], sizeof(double) * 3);
+        return;
+    }
+    double bp[3];
+    sub3(p, v[1], bp);
+    double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
+    if (d3 >= 0 && d4 <= d3) {
+        memcpy(out, v[1], sizeof(double) * 3);
+        return;
+    }
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+        double t = d1 / (d1 - d3);
+        for (int k = 0; k < 3; k++)
+            out[k] = v[0][k] + t * ab[k];
+        return;
+    }
+    double cp[3];
+    sub3(p, v[2], cp);
+    double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
+    if (d6 >= 0 && d5 <= d6) {
+        memcpy(out, v[2], sizeof(double) * 3);
+        return;
+    }
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+        double t = d2 / (d2 - d6);
+        for (int k = 0; k < 3; k++)
+            out[k] = v[0][k] + t * ac[k];
+        return;
+    }
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+        double t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        for (int k = 0; k < 3; k++)
+            out[k] = v[1][k] + t * (v[2][k] - v[1][k]);
+        return;
+    }
+    double den = 1.0 / (va + vb + vc), sv = vb * den, tw = vc * den;
+    for (int k = 0; k < 3; k++)
+        out[k] = v[0][k] + ab[k] * sv + ac[k] * tw;
+}
+
+/* Target of vertex p: the nearest ray hit along +-d within reach, else the
+ * closest surface point within reach. Returns 0 when nothing is in reach. */
+static int snap_target(const pp_mesh *m, const buckets *g, const double p[3], const double d[3],
+                       double reach, double out[3])
+{
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; k++) {
+        lo[k] = p[k] - reach;
+        hi[k] = p[k] + reach;
+    }
+    int a[3], z[3];
+    bucket_range(g, lo, hi, a, z);
+    double best_s = INFINITY, best_d2 = reach * reach;
+    int have_ray = 0, have_cp = 0;
+    double cp_best[3] = {0, 0, 0};
+    for (int k = a[2]; k <= z[2]; k++)
+        for (int j = a[1]; j <= z[1]; j++)
+            for (int i = a[0]; i <= z[0]; i++) {
+                size_t c = (size_t)i + (size_t)g->n[0] * ((size_t)j + (size_t)g->n[1] * k);
+                for (size_t q = g->start[c]; q < g->start[c + 1]; q++) {
+                    double v[3][3], s, cp[3], r[3];
+                    tri_points(m, g->tri[q], v);
+                    if (ray_tri(p, d, v, &s) && fabs(s) <= reach && fabs(s) < fabs(best_s)) {
+                        best_s = s;
+                        have_ray = 1;
+                    }
+                    closest_on_tri(p, v, cp);
+                    sub3(cp, p, r);
+                    double d2 = dot3(r, r);
+                    if (d2 < best_d2) {
+                        best_d2 = d2;
+                        memcpy(cp_best, cp, sizeof cp_best);
+                        have_cp = 1;
+                    }
+                }
+            }
+    if (have_ray) {
+        for (int k = 0; k < 3; k++)
+            out[k] = p[k] + best_s * d[k];
+        return 1;
+    }
+    if (have_cp) {
+        memcpy(out, cp_best, sizeof cp_best);
+        return 1;
+    }
+    return 0;
+}
+
+/* Shape quality of a tet with vertex `moved` at np: 6 sqrt(2) V / l_rms^3,
+ * 1 for the regular tet, 0.66 for a Kuhn tet, <= 0 when flat or inverted. */
+static double tet_shape(const float *P, const uint32_t *t, uint32_t moved, const double *np)
+{
+    double q[4][3];
+    for (int c = 0; c < 4; c++)
+        for (int k = 0; k < 3; k++)
+            q[c][k] = t[c] == moved ? np[k] : (double)P[3 * (size_t)t[c] + k];
+    double a[3], b[3], e[3], x[3];
+    sub3(q[1], q[0], a);
+    sub3(q[2], q[0], b);
+    sub3(q[3], q[0], e);
+    cross3(b, e, x);
+    double vol = dot3(a, x) / 6.0;
+    double l2 = 0.0;
+    for (int i = 0; i < 4; i++)
+        for (int j = i + 1; j < 4; j++) {
+            double d[3];
+            sub3(q[j], q[i], d);
+            l2 += dot3(d, d);
+        }
+    double rms = sqrt(l2 / 6.0);
+    return 6.0 * sqrt(2.0) * vol / (rms * rms * rms);
+}
+
+pose_status pp_tet_snap(pp_tetmesh *t, const pp_mesh *surface, const int8_t *dir, float reach,
+                        size_t *moved)
+{
+    *moved = 0;
+    if (!surface || surface->triangle_count == 0)
+        return POSE_OK;
+    size_t nv = t->vertex_count;
+    /* vertex -> incident tets (only for vertices that may move) */
+    size_t *start = calloc(nv + 1, sizeof *start);
+    if (!start)
+        return POSE_ERR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < 4 * t->tet_count; i++) {
+        uint32_t v = t->tets[i];
+        if (dir[3 * (size_t)v] | dir[3 * (size_t)v + 1] | dir[3 * (size_t)v + 2])
+            start[v + 1]++;
+    }
+    for (size_t v = 0; v < nv; v++)
+        start[v + 1] += start[v];
+    uint32_t *inc = malloc((start[nv] ? start[nv] : 1) * sizeof *inc);
+    double *q0 = malloc((start[nv] ? start[nv] : 1) * sizeof *q0);
+    buckets g = {0};
+    pose_status s = inc && q0 ? buckets_build(surface, reach, &g) : POSE_ERR_OUT_OF_MEMORY;
+    if (s != POSE_OK) {
+        free(start);
+        free(inc);
+        free(q0);
+        free(g.start);
+        free(g.tri);
+        return s;
+    }
+    size_t *fill = start; /* advanced while filling, shifted back below */
+    for (size_t i = 0; i < 4 * t->tet_count; i++) {
+        uint32_t v = t->tets[i];
+        if (dir[3 * (size_t)v] | dir[3 * (size_t)v + 1] | dir[3 * (size_t)v + 2])
+            inc[fill[v]++] = (uint32_t)(i / 4);
+    }
+    memmove(start + 1, start, nv * sizeof *start);
+    start[0] = 0;
+    for (size_t v = 0; v < nv; v++)
+        for (size_t q = start[v]; q < start[v + 1]; q++)
+            q0[q] = tet_shape(t->positions, t->tets + 4 * (size_t)inc[q], UINT32_MAX, NULL);
+
+    for (size_t v = 0; v < nv; v++) {
+        const int8_t *dv = dir + 3 * v;
+        if (!(dv[0] | dv[1] | dv[2]))
+            continue;
+        double p[3] = {t->positions[3 * v], t->positions[3 * v + 1], t->positions[3 * v + 2]};
+        double d[3] = {dv[0], dv[1], dv[2]};
+        double l = sqrt(dot3(d, d));
+        for (int k = 0; k < 3; k++)
+            d[k] /= l;
+        double target[3];
+        if (!snap_target(surface, &g, p, d, reach, target))
+            continue;
+        for (int tries = 0; tries < 3; tries++) {
+            double f = tries == 0 ? 1.0 : tries == 1 ? 0.5 : 0.25;
+            double np[3] = {p[0] + f * (target[0] - p[0]), p[1] + f * (target[1] - p[1]),
+                            p[2] + f * (target[2] - p[2])};
+            int ok = 1;
+            for (size_t q = start[v]; q < start[v + 1] && ok; q++)
+                ok = tet_shape(t->positions, t->tets + 4 * (size_t)inc[q], (uint32_t)v, np) >=
+                     fmin(PP_SNAP_MIN_SHAPE, q0[q]);
+            if (ok) {
+                for (int k = 0; k < 3; k++)
+                    t->positions[3 * v + k] = (float)np[k];
+                (*moved)++;
+                break;
+            }
+        }
+    }
+    free(start);
+    free(inc);
+    free(q0);
+    free(g.start);
+    free(g.tri);
+    return POSE_OK;
+}
