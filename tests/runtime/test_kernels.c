@@ -46,7 +46,7 @@ static void test_blend_antipodal_quaternions(void **unused)
             double p[3] = {rest[3 * v], rest[3 * v + 1], rest[3 * v + 2]}, e[3];
             dq_rot(e, q, p);
             for (int k = 0; k < 3; k++)
-                assert_float_equal(out[3 * v + k], e[k] + t[k], 1e-5);
+                assert_near(out[3 * v + k], e[k] + t[k], 1e-5);
         }
     }
 }
@@ -85,7 +85,7 @@ static void test_single_joint_rigid_all_methods(void **unused)
         pose__skin(method, &m16, pal, 0, 1, b);
         assert_memory_equal(a, b, sizeof a);
         for (int k = 0; k < 3; k++)
-            assert_float_equal(a[k], e[k] + x[2].t[k], 1e-5);
+            assert_near(a[k], e[k] + x[2].t[k], 1e-5);
     }
 }
 
@@ -161,12 +161,12 @@ static void test_transfer_affine_exact(void **unused)
             double want = off[r];
             for (int c = 0; c < 3; c++)
                 want += A[r][c] * rest_p[i][c];
-            assert_float_equal(pos[3 * i + r], want, 2e-6);
+            assert_near(pos[3 * i + r], want, 2e-6);
             nn[r] = cof[r][0] * n_rest[i][0] + cof[r][1] * n_rest[i][1] + cof[r][2] * n_rest[i][2];
             l += nn[r] * nn[r];
         }
         for (int r = 0; r < 3; r++)
-            assert_float_equal(nrm[3 * i + r], nn[r] / sqrt(l), 2e-4);
+            assert_near(nrm[3 * i + r], nn[r] / sqrt(l), 2e-4);
     }
     /* positions only (normals skipped) give the same positions */
     float pos2[3 * N];
@@ -197,7 +197,7 @@ static void test_euler_round_trip(void **unused)
             assert_true(dq_dist(qd, q2) < 2e-6);
             if (fabsf(cases[c][1]) < 89.0f)
                 for (int k = 0; k < 3; k++)
-                    assert_float_equal(back[k], deg[k], 1e-3);
+                    assert_near(back[k], deg[k], 1e-3);
         }
     }
     float q[4];

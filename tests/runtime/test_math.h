@@ -73,4 +73,7 @@ static inline double dq_dist(const double a[4], const float b[4])
     return fmin(p, m);
 }
 
+/* cmocka's assert_float_equal lets NaN through; this does not. */
+#define assert_near(a, b, tol) assert_true(fabs((double)(a) - (double)(b)) <= (double)(tol))
+
 #endif /* POSE_TEST_MATH_H */

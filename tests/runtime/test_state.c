@@ -126,14 +126,14 @@ static void test_rest_pose_exact(void **unused)
     float *rest_n = malloc(3 * n * sizeof(float));
     memcpy(rest_n, n0, 3 * n * sizeof(float));
     /* the bar's corner normals point out diagonally */
-    assert_float_equal(rest_n[0], -1.0f / sqrtf(3.0f), 1e-6f);
+    assert_near(rest_n[0], -1.0f / sqrtf(3.0f), 1e-6f);
     for (int m = 0; m < 3; m++) {
         assert_int_equal(pose_set_method(st, k_methods[m]), POSE_OK);
         assert_int_equal(pose_apply(st), POSE_OK);
         assert_rest(st, rig);
         const float *nn = pose_tissue_normals(st, 0, &n);
         for (size_t i = 0; i < 3 * n; i++)
-            assert_float_equal(nn[i], rest_n[i], 1e-4f);
+            assert_near(nn[i], rest_n[i], 1e-4f);
     }
     /* and again after posing and resetting */
     const float deg[3] = {20, -35, 50};
@@ -214,7 +214,7 @@ static void test_rigid_bone_motion(void **unused)
             double a[3] = {n_rest[3 * i], n_rest[3 * i + 1], n_rest[3 * i + 2]}, b[3];
             dq_rot(b, R, a);
             for (int k = 0; k < 3; k++)
-                assert_float_equal(nn[3 * i + k], b[k], 2e-4);
+                assert_near(nn[3 * i + k], b[k], 2e-4);
         }
         pose_state_free(rest);
         pose_state_free(st);
@@ -263,7 +263,7 @@ static void test_world_transforms_compose(void **unused)
         assert_int_equal(pose_joint_world(st, j, &w), POSE_OK);
         assert_true(dq_dist(world[j].q, w.rotation) < 2e-6);
         for (int k = 0; k < 3; k++)
-            assert_float_equal(w.translation[k], world[j].t[k], 2e-5);
+            assert_near(w.translation[k], world[j].t[k], 2e-5);
     }
     /* the last joint's own frame origin moved with it */
     pose_state_free(st);
