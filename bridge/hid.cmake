@@ -12,3 +12,9 @@ else()
   message(STATUS "pose-bridge: hidapi-hidraw not found; live HID devices disabled (recordings still work)")
 endif()
 
+
+# Generator of the reference mannequin recordings in data/hid/ (reproducible).
+add_executable(pose-hid-mannequin-gen "${CMAKE_CURRENT_SOURCE_DIR}/devices/mannequin_gen.c")
+target_link_libraries(pose-hid-mannequin-gen PRIVATE pose_bridge)
+target_compile_definitions(pose-hid-mannequin-gen PRIVATE _POSIX_C_SOURCE=200809L)
+pose_target_warnings(pose-hid-mannequin-gen)
