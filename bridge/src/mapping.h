@@ -1,0 +1,138 @@
+/* SPDX-License-Identifier: Apache-2.0
+ * Mapping files: how a source drives a rig. One JSON file (cJSON) with two
+ * optional parts:
+ *
+ *   "joints": mocap retargeting. { "<rig joint>": "<clip joint>" | {
+ *       "source": "<clip joint>", "align": true, "filter": {...} }, ... }
+ *   "channels": scalar channels (HID, CAN) driving one joint axis each:
+ *     [ { "channel": "<pb_channel.name>"  (or "usage": "0x00010030" with
+ *         optional "index": n for the n-th channel of that HID usage),
+ *         "joint": "<rig joint>", "axis": "x"|"y"|"z",
+ *         "order": "XYZ" (Euler order of this joint's channels; default XYZ),
+ *         "calibration": {"raw": [r0, r1], "deg": [d0, d1]}   two-point, or
+ *                        {"offset": o, "scale": s}            deg = (raw + o) * s,
+ *         "invert": false, "deadband": 0.0 (deg, around the last output),
+ *         "filter": {"min_cutoff": Hz, "beta": b, "d_cutoff": Hz},
+ *         "limits": [min_deg, max_deg] }, ... ]
+ *
+ * Top-level options (all optional):
+ *   "source_axes" / "rig_axes": {"up": "+y", "forward": "+z"}: the clip's
+ *       and the rig's frames; the clip's motion is rotated from one to the other.
+ *   "scale": clip length unit -> rig unit (root motion), default 1.
+ *   "root_motion": "none" | "horizontal" | "full" (default "none").
+ *   "reference": "zero" (all channels 0, default) or a frame number: the clip
+ *       pose taken to correspond to the rig's rest pose.
+ *   "align": true (default): per joint, rotate the rig's rest bone direction
+ *       onto the clip's reference bone direction, so limbs point where the
+ *       clip's do even when the two rest poses differ.
+ *   "filter": default One Euro parameters for every joint / channel.
+ * Without "joints" and "channels", clip joints drive rig joints of the same
+ * name (pb_mapping_identity).
+ */
+#ifndef POSE_BRIDGE_MAPPING_H
+#define POSE_BRIDGE_MAPPING_H
+
+#include <stdint.h>
+
+#include "handoff.h"
+#include "mocap.h"
+#include "one_euro.h"
+#include "rig_skel.h"
+#include "source.h"
+
+typedef enum pb_root_motion { PB_ROOT_NONE = 0, PB_ROOT_HORIZONTAL = 1, PB_ROOT_FULL = 2 } pb_root_motion;
+
+typedef struct pb_map_joint {
+    char rig[PB_NAME_MAX];
+    char source[PB_NAME_MAX];
+    int align;                 /**< -1: mapping default */
+    int has_filter;
+    pb_one_euro_params filter;
+} pb_map_joint;
+
+typedef enum pb_calib_kind { PB_CALIB_NONE = 0, PB_CALIB_TWO_POINT = 1, PB_CALIB_LINEAR = 2 } pb_calib_kind;
+
+typedef struct pb_map_channel {
+    char channel[PB_NAME_MAX]; /**< "" when matched by usage */
+    uint32_t usage;            /**< HID (page << 16 | usage) when channel is "" */
+    int usage_index;           /**< n-th channel with that usage */
+    char joint[PB_NAME_MAX];
+    int axis;                  /**< 0 x, 1 y, 2 z */
+    pose_euler_order order;
+    pb_calib_kind calib;
+    double raw[2], deg[2];     /**< two-point */
+    double offset, scale;      /**< linear */
+    int invert;
+    double deadband;
+    int has_filter;
+    pb_one_euro_params filter;
+    int has_limits;
+    double limit[2];
+} pb_map_channel;
+
+typedef struct pb_mapping {
+    char path[256];
+    double axes_q[4];          /**< source frame -> rig frame */
+    double up[3];              /**< the rig's up axis (for horizontal root motion) */
+    double scale;
+    pb_root_motion root_motion;
+    long reference_frame;      /**< -1: zero pose */
+    int align;
+    int has_filter;
+    pb_one_euro_params filter;
+    int identity;              /**< map joints by equal names */
+    int joint_count;
+    pb_map_joint *joints;
+    int channel_count;
+    pb_map_channel *channels;
+} pb_mapping;
+
+pose_status pb_mapping_parse(const char *json, size_t size, const char *name, pb_mapping **out, pb_error *err);
+pose_status pb_mapping_load(const char *path, pb_mapping **out, pb_error *err);
+/** A mapping that drives rig joints from clip joints of the same name. */
+pose_status pb_mapping_identity(pb_mapping **out, pb_error *err);
+void pb_mapping_free(pb_mapping *m);
+
+/* ------------------------------------------------------------ retargeting */
+
+typedef struct pb_retarget pb_retarget;
+
+/**
+ * Bind a mapping to a clip and a rig: resolves names (unknown joints are
+ * errors naming the mapping file and entry), computes the clip's reference
+ * pose and the per-joint rest alignment.
+ */
+pose_status pb_retarget_create(const pb_mapping *map, const pb_clip *clip, const pb_rig_skel *rig,
+                               pb_retarget **out, pb_error *err);
+void pb_retarget_free(pb_retarget *r);
+/**
+ * Joint targets for clip local transforms (pb_clip_local output) into out
+ * (out->joint_count == rig joints). dt_s: time since the previous call, for
+ * the filters (<= 0 resets them). Allocates nothing.
+ */
+void pb_retarget_apply(pb_retarget *r, const double (*lq)[4], const double (*lt)[3], double dt_s, pb_pose *out);
+/** Number of rig joints the mapping drives. */
+int pb_retarget_mapped_count(const pb_retarget *r);
+
+/* ------------------------------------------------------- scalar channels */
+
+typedef struct pb_chanmap pb_chanmap;
+
+/**
+ * Bind the mapping's "channels" to a source's channels (by name, or by HID
+ * usage) and to rig joints. Every entry must resolve: an unknown channel or
+ * joint is an error naming the mapping file and entry.
+ */
+pose_status pb_chanmap_create(const pb_mapping *map, const pb_channel *channels, size_t channel_count,
+                              const pb_rig_skel *rig, pb_chanmap **out, pb_error *err);
+void pb_chanmap_free(pb_chanmap *c);
+/** Feed one update (calibrate, invert, deadband, filter, limit); allocates nothing. */
+void pb_chanmap_update(pb_chanmap *c, const pb_update *u);
+/** Joint targets from the latest values (joints without channels stay inactive). */
+void pb_chanmap_pose(const pb_chanmap *c, pb_pose *out);
+/** Latest output angle (degrees) of mapping entry i, after all stages. */
+double pb_chanmap_value(const pb_chanmap *c, int entry);
+/** The calibration/inversion/deadband/limit stages alone (no filter), for tests. */
+double pb_map_channel_transform(const pb_map_channel *m, double raw);
+
+#endif /* POSE_BRIDGE_MAPPING_H */

@@ -1,0 +1,419 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+#include "runner.h"
+
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "clock.h"
+#include "pb_math.h"
+
+enum { LAG_CAPACITY = 1 << 16 };
+
+struct pb_runner {
+    pthread_t thread;
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    int started;
+    /* control, under mu */
+    int stop_req, paused, seek_req, step_req, speed_req;
+    double seek_to, speed;
+    pb_runner_stats stats;
+    int64_t fps_t0;
+    uint64_t fps_ticks0;
+    /* owned by the bridge thread */
+    pb_runner_options opt;
+    const pb_clip *clip;
+    const pb_rig_skel *rig;
+    pb_player player;
+    pb_retarget *rt;
+    pb_chanmap *cm;
+    pb_source *src;
+    pb_recorder *rec;
+    pb_handoff h;
+    pb_clock clock;
+    double period;
+    double (*lq)[4], (*lt)[3];
+    int64_t *lags;
+    size_t lag_count;
+    pb_error err;
+    pose_status status;
+};
+
+static void abs_deadline(int64_t t_ns, struct timespec *ts)
+{
+    ts->tv_sec = (time_t)(t_ns / 1000000000);
+    ts->tv_nsec = (long)(t_ns % 1000000000);
+}
+
+static void note_tick(pb_runner *r, const pb_pose *p, int64_t lag_ns)
+{
+    /* caller holds mu */
+    r->stats.ticks++;
+    r->stats.frame = p->frame;
+    r->stats.media_s = p->media_s;
+    r->stats.lag_ms = (double)lag_ns * 1e-6;
+    if (r->stats.lag_ms > r->stats.lag_max_ms)
+        r->stats.lag_max_ms = r->stats.lag_ms;
+    if (p->t_ns - r->fps_t0 >= 1000000000 || r->fps_t0 == 0) {
+        if (r->fps_t0)
+            r->stats.fps = (double)(r->stats.ticks - r->fps_ticks0) * 1e9 / (double)(p->t_ns - r->fps_t0);
+        r->fps_t0 = p->t_ns;
+        r->fps_ticks0 = r->stats.ticks;
+    }
+    if (r->lags && r->lag_count < LAG_CAPACITY)
+        r->lags[r->lag_count++] = lag_ns;
+}
+
+static void finish(pb_runner *r, pb_source_state st)
+{
+    pthread_mutex_lock(&r->mu);
+    r->stats.state = st;
+    r->stats.running = 0;
+    pthread_cond_broadcast(&r->cv);
+    pthread_mutex_unlock(&r->mu);
+}
+
+/* Publish the back slot, record it; returns nonzero on a recording error. */
+static int publish(pb_runner *r, pb_pose *back, int64_t lag_ns)
+{
+    pb_handoff_publish(&r->h);
+    int bad = 0;
+    if (r->rec && pb_recorder_write(r->rec, back, &r->err) != POSE_OK) {
+        r->status = POSE_ERR_IO;
+        bad = 1;
+    }
+    pthread_mutex_lock(&r->mu);
+    note_tick(r, back, lag_ns);
+    pthread_mutex_unlock(&r->mu);
+    return bad;
+}
+
+static void *clip_thread(void *arg)
+{
+    pb_runner *r = arg;
+    double next = r->opt.start_s, first = r->opt.start_s;
+    pb_clock_start(&r->clock, r->speed, next, pb_now_ns());
+    if (r->paused)
+        pb_clock_pause(&r->clock, 1, pb_now_ns());
+    for (;;) {
+        int stepping = 0;
+        int64_t deadline = 0;
+        pthread_mutex_lock(&r->mu);
+        for (;;) {
+            int64_t now = pb_now_ns();
+            if (r->stop_req)
+                break;
+            if (r->seek_req) {
+                pb_clock_seek(&r->clock, r->seek_to, now);
+                next = r->seek_to;
+                r->seek_req = 0;
+            }
+            if (r->speed_req) {
+                pb_clock_set_speed(&r->clock, r->speed, now);
+                r->speed_req = 0;
+            }
+            if (r->paused != r->clock.paused) {
+                pb_clock_pause(&r->clock, r->paused, now);
+                if (!r->paused)
+                    pb_clock_seek(&r->clock, next, now); /* resume where the last tick was due */
+            }
+            if (r->paused) {
+                if (r->step_req > 0) {
+                    r->step_req--;
+                    stepping = 1;
+                    deadline = now;
+                    break;
+                }
+                struct timespec ts;
+                abs_deadline(now + 50000000, &ts);
+                pthread_cond_timedwait(&r->cv, &r->mu, &ts);
+                continue;
+            }
+            if (r->opt.afap) {
+                deadline = now;
+                break;
+            }
+            deadline = pb_clock_wall(&r->clock, next);
+            if (deadline <= now)
+                break;
+            struct timespec ts;
+            abs_deadline(deadline, &ts);
+            if (pthread_cond_timedwait(&r->cv, &r->mu, &ts) != 0 && pb_now_ns() >= deadline)
+                break; /* timed out: the tick is due (commands re-checked otherwise) */
+        }
+        int stop = r->stop_req;
+        pthread_mutex_unlock(&r->mu);
+        if (stop)
+            break;
+        int64_t woke = pb_now_ns();
+        double t;
+        int past_end = pb_player_wrap(&r->player, next, &t);
+        pb_player_sample(&r->player, t, r->lq, r->lt);
+        pb_pose *back = pb_handoff_back(&r->h);
+        pb_retarget_apply(r->rt, (const double (*)[4])r->lq, (const double (*)[3])r->lt, r->period, back);
+        back->t_ns = woke;
+        back->media_s = next;
+        back->frame = (long)floor(t / r->clip->frame_time + 1e-9);
+        if (publish(r, back, stepping ? 0 : woke - deadline))
+            break;
+        next += r->period;
+        if (past_end || (r->opt.max_ticks > 0 && r->stats.ticks >= (uint64_t)r->opt.max_ticks) ||
+            (r->opt.max_media_s > 0 && next - first > r->opt.max_media_s + 1e-9)) {
+            finish(r, PB_SOURCE_ENDED);
+            return NULL;
+        }
+    }
+    finish(r, r->status ? PB_SOURCE_FAULT : PB_SOURCE_ENDED);
+    return NULL;
+}
+
+static void *source_thread(void *arg)
+{
+    pb_runner *r = arg;
+    int64_t t0 = pb_now_ns();
+    for (;;) {
+        pthread_mutex_lock(&r->mu);
+        int stop = r->stop_req;
+        pthread_mutex_unlock(&r->mu);
+        if (stop)
+            break;
+        pb_update u;
+        int got = pb_source_read(r->src, &u, 20);
+        if (got < 0) {
+            if (r->src->state == PB_SOURCE_ENDED) {
+                finish(r, PB_SOURCE_ENDED);
+                return NULL;
+            }
+            pb_sleep_until_ns(pb_now_ns() + 20000000); /* the backend retries; do not spin */
+            continue;
+        }
+        if (got == 0)
+            continue;
+        pb_chanmap_update(r->cm, &u);
+        pb_pose *back = pb_handoff_back(&r->h);
+        pb_chanmap_pose(r->cm, back);
+        back->t_ns = pb_now_ns();
+        back->media_s = (double)(u.t_ns - t0) * 1e-9;
+        back->frame = -1;
+        if (publish(r, back, 0))
+            break;
+        if (r->opt.max_ticks > 0 && r->stats.ticks >= (uint64_t)r->opt.max_ticks) {
+            finish(r, PB_SOURCE_ENDED);
+            return NULL;
+        }
+    }
+    finish(r, r->status ? PB_SOURCE_FAULT : PB_SOURCE_ENDED);
+    return NULL;
+}
+
+static void runner_free(pb_runner *r)
+{
+    if (!r)
+        return;
+    pb_retarget_free(r->rt);
+    pb_chanmap_free(r->cm);
+    pb_source_destroy(r->src);
+    pb_player_free(&r->player);
+    pb_recorder_close(r->rec, NULL);
+    pb_handoff_free(&r->h);
+    free(r->lq);
+    free(r->lt);
+    free(r->lags);
+    pthread_mutex_destroy(&r->mu);
+    pthread_cond_destroy(&r->cv);
+    free(r);
+}
+
+static pose_status runner_new(const pb_rig_skel *rig, const pb_runner_options *opt, double frame_time,
+                              pb_runner **out, pb_error *err)
+{
+    pb_runner *r = calloc(1, sizeof *r);
+    if (!r)
+        return pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+    pthread_mutex_init(&r->mu, NULL);
+    pthread_condattr_t ca;
+    pthread_condattr_init(&ca);
+    pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
+    pthread_cond_init(&r->cv, &ca);
+    pthread_condattr_destroy(&ca);
+    if (opt)
+        r->opt = *opt;
+    r->rig = rig;
+    r->speed = r->opt.speed > 0 ? r->opt.speed : 1.0;
+    r->paused = r->opt.start_paused;
+    r->period = r->opt.rate_hz > 0 ? r->speed / r->opt.rate_hz : frame_time;
+    r->stats.state = PB_SOURCE_WAITING;
+    r->stats.running = 1;
+    r->stats.frame = -1;
+    r->lags = malloc(LAG_CAPACITY * sizeof *r->lags);
+    if (!r->lags || pb_handoff_init(&r->h, rig->joint_count) != 0) {
+        runner_free(r);
+        return pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+    }
+    if (r->opt.record_path) {
+        pose_status s = pb_recorder_open(r->opt.record_path, rig, r->period, &r->rec, err);
+        if (s) {
+            runner_free(r);
+            return s;
+        }
+    }
+    *out = r;
+    return POSE_OK;
+}
+
+static pose_status runner_launch(pb_runner *r, void *(*fn)(void *), pb_runner **out, pb_error *err)
+{
+    if (pthread_create(&r->thread, NULL, fn, r) != 0) {
+        runner_free(r);
+        return pb_fail(err, POSE_ERR_THREAD, "cannot start the bridge thread");
+    }
+    r->started = 1;
+    *out = r;
+    return POSE_OK;
+}
+
+pose_status pb_runner_start_clip(const pb_clip *clip, const pb_rig_skel *rig, const pb_mapping *map,
+                                 const pb_runner_options *opt, pb_runner **out, pb_error *err)
+{
+    if (!clip || !rig || !map || !out)
+        return pb_fail(err, POSE_ERR_INVALID_ARGUMENT, "pb_runner_start_clip: NULL argument");
+    *out = NULL;
+    pb_runner *r;
+    pose_status s = runner_new(rig, opt, clip->frame_time, &r, err);
+    if (s)
+        return s;
+    r->clip = clip;
+    size_t n = (size_t)(clip->joint_count > 0 ? clip->joint_count : 1);
+    r->lq = malloc(n * sizeof *r->lq);
+    r->lt = malloc(n * sizeof *r->lt);
+    if (!r->lq || !r->lt)
+        s = pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+    if (!s)
+        s = pb_player_init(&r->player, clip, r->opt.loop, err);
+    if (!s)
+        s = pb_retarget_create(map, clip, rig, &r->rt, err);
+    if (s) {
+        runner_free(r);
+        return s;
+    }
+    r->stats.state = PB_SOURCE_OK;
+    return runner_launch(r, clip_thread, out, err);
+}
+
+pose_status pb_runner_start_source(pb_source *src, const pb_rig_skel *rig, const pb_mapping *map,
+                                   const pb_runner_options *opt, pb_runner **out, pb_error *err)
+{
+    if (!src || !rig || !map || !out)
+        return pb_fail(err, POSE_ERR_INVALID_ARGUMENT, "pb_runner_start_source: NULL argument");
+    *out = NULL;
+    pb_runner *r;
+    pose_status s = runner_new(rig, opt, 0.01, &r, err);
+    if (s)
+        return s;
+    s = pb_chanmap_create(map, src->channels, src->channel_count, rig, &r->cm, err);
+    if (s) {
+        runner_free(r);
+        return s;
+    }
+    r->src = src;
+    r->stats.state = PB_SOURCE_OK;
+    return runner_launch(r, source_thread, out, err);
+}
+
+const pb_pose *pb_runner_latest(pb_runner *r, int *fresh) { return pb_handoff_latest(&r->h, fresh); }
+
+void pb_runner_stats_get(pb_runner *r, pb_runner_stats *out)
+{
+    pthread_mutex_lock(&r->mu);
+    *out = r->stats;
+    pthread_mutex_unlock(&r->mu);
+}
+
+void pb_runner_pause(pb_runner *r, int paused)
+{
+    pthread_mutex_lock(&r->mu);
+    r->paused = paused != 0;
+    pthread_cond_broadcast(&r->cv);
+    pthread_mutex_unlock(&r->mu);
+}
+
+void pb_runner_seek(pb_runner *r, double media_s)
+{
+    pthread_mutex_lock(&r->mu);
+    r->seek_to = media_s;
+    r->seek_req = 1;
+    pthread_cond_broadcast(&r->cv);
+    pthread_mutex_unlock(&r->mu);
+}
+
+void pb_runner_step(pb_runner *r, int ticks)
+{
+    pthread_mutex_lock(&r->mu);
+    r->step_req += ticks > 0 ? ticks : 0;
+    pthread_cond_broadcast(&r->cv);
+    pthread_mutex_unlock(&r->mu);
+}
+
+void pb_runner_set_speed(pb_runner *r, double speed)
+{
+    if (!(speed > 0))
+        return;
+    pthread_mutex_lock(&r->mu);
+    r->speed = speed;
+    r->speed_req = 1;
+    pthread_cond_broadcast(&r->cv);
+    pthread_mutex_unlock(&r->mu);
+}
+
+int pb_runner_wait(pb_runner *r, int timeout_ms)
+{
+    int64_t until = timeout_ms < 0 ? INT64_MAX : pb_now_ns() + (int64_t)timeout_ms * 1000000;
+    pthread_mutex_lock(&r->mu);
+    while (r->stats.running) {
+        if (until == INT64_MAX) {
+            pthread_cond_wait(&r->cv, &r->mu);
+        } else {
+            struct timespec ts;
+            abs_deadline(until, &ts);
+            if (pthread_cond_timedwait(&r->cv, &r->mu, &ts) != 0 && pb_now_ns() >= until)
+                break;
+        }
+    }
+    int ended = !r->stats.running;
+    pthread_mutex_unlock(&r->mu);
+    return ended;
+}
+
+size_t pb_runner_lags(pb_runner *r, int64_t *out, size_t capacity)
+{
+    pthread_mutex_lock(&r->mu);
+    size_t n = r->lag_count < capacity ? r->lag_count : capacity;
+    memcpy(out, r->lags, n * sizeof *out);
+    pthread_mutex_unlock(&r->mu);
+    return n;
+}
+
+pose_status pb_runner_stop(pb_runner *r, pb_error *err)
+{
+    if (!r)
+        return POSE_OK;
+    pthread_mutex_lock(&r->mu);
+    r->stop_req = 1;
+    pthread_cond_broadcast(&r->cv);
+    pthread_mutex_unlock(&r->mu);
+    if (r->started)
+        pthread_join(r->thread, NULL);
+    pose_status s = r->status;
+    if (s && err)
+        *err = r->err;
+    if (r->rec) {
+        pose_status c = pb_recorder_close(r->rec, err);
+        r->rec = NULL;
+        if (!s)
+            s = c;
+    }
+    runner_free(r);
+    return s;
+}
