@@ -38,7 +38,7 @@ void ex_camera_frame(ex_camera *cam, const float bmin[3], const float bmax[3], f
     float half = 0.5f * cam->fov_deg * ex_deg;
     float half_x = atanf(tanf(half) * (aspect > 0.0f ? aspect : 1.0f));
     float fit = half < half_x ? half : half_x;
-    cam->distance = cam->radius / sinf(fit) * 0.92f;
+    cam->distance = cam->radius / sinf(fit); /* the bounding sphere just fits */
 }
 
 void ex_camera_eye(const ex_camera *cam, float eye[3])

@@ -26,6 +26,7 @@ typedef struct options {
     const char *poses[MAX_POSES];
     int pose_count;
     int width, height, supersample, turntable, compare, json, threads, list_joints;
+    int fit_rest; /* frame the camera on the rest pose only (comparable images across calls) */
     int method; /* -1: CoR when the rig has it, else LBS */
     long *frames;
     size_t frame_count;
@@ -64,6 +65,8 @@ static void usage(FILE *f)
           "  --weights JOINT              colour the tet mesh by this joint's skinning weight\n"
           "  --caption TEXT               caption drawn at the top of each image\n"
           "  --azimuth DEG --elevation DEG --zoom F   camera (default: frames the whole model)\n"
+          "  --fit pose|rest              frame the rest pose and every pose shown (default), or the\n"
+          "                               rest pose only, so separate runs share one camera\n"
           "  --size WxH                   image size (default 640x640; a panel is 3 of these)\n"
           "  --supersample N              anti-aliasing factor 1..4 (default 2)\n"
           "  --threads N                  pose_apply worker threads (default: cores)\n"
@@ -173,6 +176,12 @@ static int parse_args(int argc, char **argv, options *o, char *err, size_t err_s
                 return -1;
             }
             o->skin = (ex_skin_mode)m;
+        } else if (!strcmp(a, "--fit")) {
+            if (strcmp(v, "pose") && strcmp(v, "rest")) {
+                snprintf(err, err_size, "--fit: expected pose or rest, got '%s'", v);
+                return -1;
+            }
+            o->fit_rest = !strcmp(v, "rest");
         } else if (!strcmp(a, "--hide")) {
             if (parse_kinds(v, &o->hide, err, err_size) < 0)
                 return -1;
@@ -414,15 +423,15 @@ static int run(const options *o, summary *s, char *err, size_t err_size)
     float bmin[3], bmax[3];
     if (ex_scene_apply(&sc, err, err_size) < 0)
         goto done;
-    ex_scene_bounds(&sc, 1, bmin, bmax);
-    if (motion)
+    ex_scene_bounds(&sc, !o->fit_rest, bmin, bmax);
+    if (motion && !o->fit_rest)
         for (size_t i = 0; i < o->frame_count; i++) {
             if (ex_motion_set_frame(motion, sc.state, o->frames[i], err, err_size) < 0 ||
                 ex_scene_apply(&sc, err, err_size) < 0)
                 goto done;
             grow_bounds(&sc, bmin, bmax);
         }
-    if (o->compare)
+    if (o->compare && !o->fit_rest)
         for (int m = 0; m < 3; m++)
             if (pose_set_method(sc.state, (pose_method)m) == POSE_OK && ex_scene_apply(&sc, err, err_size) == 0)
                 grow_bounds(&sc, bmin, bmax);

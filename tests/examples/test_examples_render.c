@@ -7,7 +7,8 @@
  * non-zero exit; pose-view without a display refuses plainly; the
  * quickstart runs; pose-export writes files other tools can read.
  *
- * argv: pose-render pose-synth pose-view|- pose-export pose-quickstart
+ * argv: pose-render pose-synth pose-view|- pose-export pose-quickstart MAP
+ * (MAP: a bridge mapping from the CMU skeleton onto the bar)
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -15,13 +16,14 @@
 #include <stdint.h>
 
 #include <cmocka.h>
+#include <math.h>
 #include <png.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
 
-static const char *render_bin, *synth_bin, *view_bin, *export_bin, *quickstart_bin;
+static const char *render_bin, *synth_bin, *view_bin, *export_bin, *quickstart_bin, *bar_map;
 static char tmp[2048], bar[2300];
 
 /* Run a shell command; its stdout+stderr go to `log`. Returns the exit status. */
@@ -138,7 +140,7 @@ static void test_bad_options(void **state)
     assert_non_null(strstr(slurp(log), "--frames needs --source"));
     assert_int_equal(run(log, "'%s' '%s' --pose nosuchjoint=0,0,0 -o '%s/x.png'", render_bin, bar, tmp), 1);
     assert_non_null(strstr(slurp(log), "no joint 'nosuchjoint'"));
-    assert_int_equal(run(log, "'%s' '%s' --pose bone1=1,2 -o '%s/x.png'", render_bin, bar, tmp), 1);
+    assert_int_equal(run(log, "'%s' '%s' --pose joint1=1,2 -o '%s/x.png'", render_bin, bar, tmp), 1);
     assert_non_null(strstr(slurp(log), "three angles"));
     assert_int_equal(run(log, "'%s' '%s' -o '%s/no/such/dir/x.png'", render_bin, bar, tmp), 1);
     assert_non_null(strstr(slurp(log), "cannot create"));
@@ -214,8 +216,8 @@ static void test_silhouette_follows_pose(void **state)
         snprintf(png, sizeof png, "%s/seq_%d.png", tmp, i);
         /* Fixed camera (side view of the bar), so images are comparable. */
         assert_int_equal(run(log,
-                             "'%s' '%s' --size 320x240 --azimuth 90 --elevation 0 --zoom 0.8 "
-                             "--pose bone2=0,%d,0 -o '%s'",
+                             "'%s' '%s' --size 320x240 --azimuth 90 --elevation 0 --fit rest "
+                             "--pose joint2=0,%d,0 -o '%s'",
                              render_bin, bar, angles[i], png),
                          0);
         im[i] = load_png(png);
@@ -225,9 +227,69 @@ static void test_silhouette_follows_pose(void **state)
         for (size_t y = 0; y < im[0].h; y++)
             for (size_t x = 0; x < im[0].w; x++)
                 diff[k] += (size_t)(is_fg(&im[0], x, y) != is_fg(&im[k + 1], x, y));
-    printf("silhouette pixels changed: %zu (30 deg), %zu (80 deg)\n", diff[0], diff[1]);
-    assert_true(diff[0] > 200);
-    assert_true(diff[1] > diff[0] + 200);
+    /* The silhouette's centroid moves away from rest, further for the larger bend. */
+    double c[3][2];
+    for (int i = 0; i < 3; i++) {
+        double sx = 0.0, sy = 0.0, n = 0.0;
+        for (size_t y = 0; y < im[i].h; y++)
+            for (size_t x = 0; x < im[i].w; x++)
+                if (is_fg(&im[i], x, y)) {
+                    sx += (double)x;
+                    sy += (double)y;
+                    n += 1.0;
+                }
+        assert_true(n > 0.0);
+        c[i][0] = sx / n;
+        c[i][1] = sy / n;
+    }
+    double shift30 = hypot(c[1][0] - c[0][0], c[1][1] - c[0][1]), shift80 = hypot(c[2][0] - c[0][0], c[2][1] - c[0][1]);
+    printf("silhouette pixels changed: %zu (30 deg), %zu (80 deg); centroid moved %.1f px, %.1f px\n", diff[0],
+           diff[1], shift30, shift80);
+    assert_true(diff[0] > 200 && diff[1] > 200);
+    assert_true(shift30 > 2.0);
+    assert_true(shift80 > shift30 + 2.0);
+    for (int i = 0; i < 3; i++)
+        free(im[i].px);
+}
+
+/* A real clip replayed through the bridge: the bar follows the CMU walk's right leg. */
+static void test_silhouette_follows_replay(void **state)
+{
+    (void)state;
+    char log[2400], dir[2400];
+    snprintf(log, sizeof log, "%s/replay.log", tmp);
+    assert_int_equal(run(log, "'%s' --help", render_bin), 0);
+    if (strstr(slurp(log), "built without the bridge"))
+        skip();
+    const char *data = getenv("POSE_DATA_DIR");
+    assert_non_null(data);
+    snprintf(dir, sizeof dir, "%s/replay", tmp);
+    /* Frames past the clip's end are refused before anything is drawn. */
+    assert_int_equal(run(log, "'%s' '%s' --source '%s/mocap/cmu-bvh/131_01.bvh' --map '%s' --frames 999999 -o '%s'",
+                         render_bin, bar, data, bar_map, dir),
+                     1);
+    assert_non_null(strstr(slurp(log), "past the end"));
+    static const long frames[3] = {101, 161, 221};
+    assert_int_equal(run(log,
+                         "'%s' '%s' --source '%s/mocap/cmu-bvh/131_01.bvh' --map '%s' --frames 101-221:60 "
+                         "--size 240x240 -o '%s'",
+                         render_bin, bar, data, bar_map, dir),
+                     0);
+    image im[3];
+    for (int i = 0; i < 3; i++) {
+        char png[2500];
+        snprintf(png, sizeof png, "%s/frame_%05ld.png", dir, frames[i]);
+        im[i] = load_png(png);
+        assert_true(coverage(&im[i]) > 0.01);
+    }
+    for (int k = 0; k < 2; k++) {
+        size_t diff = 0;
+        for (size_t y = 0; y < im[0].h; y++)
+            for (size_t x = 0; x < im[0].w; x++)
+                diff += (size_t)(is_fg(&im[k], x, y) != is_fg(&im[k + 1], x, y));
+        printf("replay: silhouette pixels changed from frame %ld to %ld: %zu\n", frames[k], frames[k + 1], diff);
+        assert_true(diff > 300); /* a quarter of a gait cycle apart */
+    }
     for (int i = 0; i < 3; i++)
         free(im[i].px);
 }
@@ -271,8 +333,8 @@ static void test_lbs_vs_cor_twist(void **state)
         char png[2400];
         snprintf(png, sizeof png, "%s/twist_%s.png", tmp, methods[m]);
         assert_int_equal(run(log,
-                             "'%s' '%s' --size 480x240 --azimuth 90 --elevation 0 --skin opaque "
-                             "--pose bone2=135,0,0 --method %s -o '%s'",
+                             "'%s' '%s' --size 480x240 --azimuth 90 --elevation 0 --fit rest --skin opaque "
+                             "--pose joint2=135,0,0 --method %s -o '%s'",
                              render_bin, bar, methods[m], png),
                          0);
         image im = load_png(png);
@@ -291,7 +353,7 @@ static void test_compare_panel(void **state)
     char log[2400], png[2400];
     snprintf(png, sizeof png, "%s/panel.png", tmp);
     snprintf(log, sizeof log, "%s/panel.log", tmp);
-    assert_int_equal(run(log, "'%s' '%s' --size 200x200 --compare --pose bone2=0,90,0 --caption test -o '%s'",
+    assert_int_equal(run(log, "'%s' '%s' --size 200x200 --compare --pose joint2=0,90,0 --caption test -o '%s'",
                          render_bin, bar, png),
                      0);
     image im = load_png(png);
@@ -330,7 +392,7 @@ static void test_quickstart(void **state)
     (void)state;
     char log[2400];
     snprintf(log, sizeof log, "%s/quick.log", tmp);
-    assert_int_equal(run(log, "'%s' '%s' bone2", quickstart_bin, bar), 0);
+    assert_int_equal(run(log, "'%s' '%s' joint2", quickstart_bin, bar), 0);
     const char *out = slurp(log);
     const char *moved = strstr(out, "moved up to ");
     assert_non_null(moved);
@@ -349,7 +411,7 @@ static void test_export(void **state)
     snprintf(obj, sizeof obj, "%s/bent.obj", tmp);
     snprintf(vtu, sizeof vtu, "%s/bent.vtu", tmp);
     snprintf(ply, sizeof ply, "%s/ply", tmp);
-    assert_int_equal(run(log, "'%s' '%s' --pose bone2=0,90,0 --obj '%s' --ply '%s' --vtu '%s' --weights bone2",
+    assert_int_equal(run(log, "'%s' '%s' --pose joint2=0,90,0 --obj '%s' --ply '%s' --vtu '%s' --weights joint2",
                          export_bin, bar, obj, ply, vtu),
                      0);
     /* OBJ: as many v lines as the rig has tissue vertices, faces index within range. */
@@ -391,8 +453,8 @@ static void test_export(void **state)
 
 int main(int argc, char **argv)
 {
-    if (argc < 6) {
-        fprintf(stderr, "usage: %s pose-render pose-synth pose-view|- pose-export pose-quickstart\n", argv[0]);
+    if (argc < 7) {
+        fprintf(stderr, "usage: %s pose-render pose-synth pose-view|- pose-export pose-quickstart MAP\n", argv[0]);
         return 2;
     }
     render_bin = argv[1];
@@ -400,6 +462,7 @@ int main(int argc, char **argv)
     view_bin = argv[3];
     export_bin = argv[4];
     quickstart_bin = argv[5];
+    bar_map = argv[6];
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_missing_rig),
         cmocka_unit_test(test_not_a_rig),
@@ -408,6 +471,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_view_without_display),
         cmocka_unit_test(test_rest_image_not_blank),
         cmocka_unit_test(test_silhouette_follows_pose),
+        cmocka_unit_test(test_silhouette_follows_replay),
         cmocka_unit_test(test_lbs_vs_cor_twist),
         cmocka_unit_test(test_compare_panel),
         cmocka_unit_test(test_turntable),
