@@ -297,7 +297,7 @@ int pp_cor_compute(const pp_tetmesh *m, const pp_weights *w, const pp_cor_option
     pp_cor_report rep;
     memset(&rep, 0, sizeof rep);
     double sigma = opt && opt->sigma > 0 ? opt->sigma : 0.1;
-    double tol = opt && opt->tolerance != 0 ? opt->tolerance : 1e-3;
+    double tol = opt && opt->tolerance != 0 ? opt->tolerance : 1e-4;
     double inv_tol = tol > 0 ? 1.0 / tol : 0;
     int threads = opt && opt->threads > 1 ? opt->threads : 1;
     size_t n = m->vertex_count, nt = m->tet_count;

@@ -24,7 +24,8 @@
 
 typedef struct pp_cor_options {
     double sigma;     /**< σ; 0 = 0.1 */
-    double tolerance; /**< weight quantum for clustering; 0 = 1e-3; < 0 = no clustering */
+    double tolerance; /**< weight quantum for clustering; 0 = 1e-4 (max deviation from the
+                           direct formula ~1e-4 of the model size); < 0 = no clustering */
     int threads;      /**< <= 1 runs on the caller's thread */
 } pp_cor_options;
 
