@@ -107,12 +107,13 @@ int pb_candump_parse_line(const char *line, size_t len, pb_can_frame *f, char *i
         }
         f->id = id;
     } else if (idlen == 8) {
+        if (id & 0xc0000000u) { /* the EFF and RTR flag bits are never written as id digits */
+            *why = "identifier above 0x3FFFFFFF";
+            return -1;
+        }
         if (id & PB_CANDUMP_ERR_FLAG) {
             f->flags |= PB_CAN_ERR;
             f->id = id & 0x1fffffffu;
-        } else if (id > 0x1fffffff) {
-            *why = "extended identifier above 0x1FFFFFFF";
-            return -1;
         } else {
             f->flags |= PB_CAN_EXT;
             f->id = id;
