@@ -24,12 +24,13 @@ clip="$root/data/mocap/cmu-bvh/131_01.bvh"
 
 usage() {
     cat <<EOF
-usage: bash scripts/demo.sh [--view] [--no-deps] [--out DIR] [--jobs N]
+usage: bash scripts/demo.sh [--view] [--no-deps] [--out DIR] [--build DIR] [--jobs N]
 Install dependencies, build, bake the bundled anatomy, replay a CMU walk
 onto it and render PNG frames (headless). Results go to out/demo/.
   --view      afterwards open pose-view on the result (needs \$DISPLAY)
   --no-deps   skip scripts/install-deps.sh (packages already present)
   --out DIR   where to write the rig, images and logs (default out/demo)
+  --build DIR build folder (default build/)
   --jobs N    parallel build jobs (default: number of cores)
 EOF
 }
@@ -39,6 +40,7 @@ while [ $# -gt 0 ]; do
     --view) view=1 ;;
     --no-deps) deps=0 ;;
     --out) out=$(mkdir -p "$2" && cd "$2" && pwd); shift ;;
+    --build) build=$(mkdir -p "$2" && cd "$2" && pwd); shift ;;
     --jobs) jobs=$2; shift ;;
     -h | --help) usage; exit 0 ;;
     *) echo "demo: unknown option '$1'" >&2; usage >&2; exit 2 ;;
@@ -115,40 +117,54 @@ if [ $have_bake -eq 1 ]; then
     rig="$out/body.rig"
     "$bake" --template "$root/preprocess/templates/full_body.json" --anatomy "$root/data/anatomy" \
         --resolution demo -o "$rig" 2>&1 | tee -a "$log" || die "pose-bake failed; see $log"
-    map="$root/bridge/maps/cmu_to_full_body.json"
+    map="$root/bridge/maps/cmu131_bvh_to_full_body.json"
+    kind=body
 else
     stage "3/5 bake: pose-bake is not in this build yet - using the synthetic four-bone bar instead"
     [ -n "$synth" ] || die "neither pose-bake nor pose-synth was built; see $log"
     rig="$out/bar.rig"
     "$synth" bar -o "$rig" | tee -a "$log"
-    map="$root/bridge/maps/cmu_to_bar.json"
+    # The CMU clip's right arm (shoulder, elbow, wrist, hand) drives the bar's four joints.
+    map="$root/bridge/maps/cmu131_arm_to_bar.json"
+    kind=bar
 fi
+joints=$("$render" "$rig" --list-joints | awk '{print $1}')
+joint=$(grep -x -m1 -e knee_r -e joint2 <<<"$joints" || sed -n 3p <<<"$joints")
 
-frames=()
-if [ $have_replay -eq 1 ] && [ $have_source -eq 1 ] && [ -f "$map" ]; then
-    stage "4/5 replay $(basename "$clip") through the bridge"
-    "$bridge" replay "$clip" --rig "$rig" --map "$map" --speed 0 2>&1 | tail -n 5 | tee -a "$log" ||
-        die "pose-bridge replay failed; see $log"
+if [ $have_source -eq 1 ] && [ -n "$map" ] && [ -f "$map" ]; then
+    stage "4/5 replay $(basename "$clip") (CMU walk) onto the $kind through the bridge, mapping $(basename "$map")"
+    if [ $have_replay -eq 1 ]; then
+        # Real time (x1) for the first 4 s: the bridge thread publishes, a 60 Hz host loop applies.
+        echo "pose-bridge replay, first 4 s in real time:"
+        "$bridge" replay "$clip" --rig "$rig" --map "$map" --duration 4 --quiet --json 2>>"$log" |
+            tee -a "$log" | sed 's/^/  /'
+        [ "${PIPESTATUS[0]}" -eq 0 ] || die "pose-bridge replay failed; see $log"
+    else
+        echo "(pose-bridge replay is not in this build yet: the frames below are decoded, retargeted"
+        echo " and applied by the bridge library linked into pose-render)"
+    fi
     stage "5/5 render frames (OSMesa, off-screen)"
-    "$render" "$rig" --source "$clip" --map "$map" --frames 1-361:40 --caption "CMU 131_01 walk" \
+    "$render" "$rig" --source "$clip" --map "$map" --frames 1-961:60 --caption "CMU 131_01 walk" \
         -o "$frames_dir" | tee -a "$log"
+    "$render" "$rig" --compare --source "$clip" --map "$map" --frames 481 --caption "walk frame 481" \
+        -o "$out/compare_walk.png" | tee -a "$log"
 else
-    stage "4/5 replay: the bridge's mocap replay is not in this build yet - posing by hand instead"
-    joint=$("$render" "$rig" --list-joints | awk 'NR == 3 {print $1}')
-    [ -n "$joint" ] || die "could not list the rig's joints"
-    echo "joint $joint: a bend of 0, 30, 60, 90 deg; LBS | DQS | CoR panels of a 90 deg bend and a 135 deg twist"
+    stage "4/5 replay: this build has no bridge - posing joint $joint by hand instead"
     stage "5/5 render frames (OSMesa, off-screen)"
     for a in 0 30 60 90; do
         "$render" "$rig" --pose "$joint=0,$a,0" --caption "bend $a deg" \
             -o "$frames_dir/bend_$(printf %03d "$a").png" | tee -a "$log"
     done
-    "$render" "$rig" --compare --pose "$joint=0,90,0" --caption "bend 90 deg at $joint" \
-        -o "$out/compare_bend.png" | tee -a "$log"
-    "$render" "$rig" --compare --pose "$joint=135,0,0" --caption "twist 135 deg at $joint" \
-        -o "$out/compare_twist.png" | tee -a "$log"
-    "$render" "$rig" --weights "$joint" --caption "weight of $joint" -o "$out/weights.png" | tee -a "$log"
-    [ -n "$export_tool" ] && "$export_tool" "$rig" --pose "$joint=0,90,0" --obj "$out/bent.obj" \
-        --vtu "$out/bent.vtu" | tee -a "$log"
+fi
+# The paper's comparisons (Fig. 7-8) on the same rig, and the weights of one joint (Fig. 5).
+"$render" "$rig" --compare --pose "$joint=0,90,0" --caption "bend 90 deg at $joint" \
+    -o "$out/compare_bend.png" | tee -a "$log"
+"$render" "$rig" --compare --pose "$joint=135,0,0" --caption "twist 135 deg at $joint" \
+    -o "$out/compare_twist.png" | tee -a "$log"
+"$render" "$rig" --weights "$joint" --caption "weight of $joint" -o "$out/weights.png" | tee -a "$log"
+if [ -n "$export_tool" ]; then
+    "$export_tool" "$rig" --pose "$joint=0,90,0" --obj "$out/posed.obj" --vtu "$out/posed.vtu" \
+        --weights "$joint" | tee -a "$log"
 fi
 
 now=$(date +%s)
@@ -162,7 +178,7 @@ if [ $view -eq 1 ]; then
         echo "demo: --view asked, but there is no display (DISPLAY is unset); the PNGs above are the result"
     elif [ -z "$pose_view" ]; then
         echo "demo: --view asked, but pose-view was not built (needs libglfw3-dev)"
-    elif [ $have_replay -eq 1 ] && [ $have_source -eq 1 ] && [ -f "$map" ]; then
+    elif [ $have_source -eq 1 ] && [ -n "$map" ] && [ -f "$map" ]; then
         "$pose_view" "$rig" --source "$clip" --map "$map"
     else
         "$pose_view" "$rig"

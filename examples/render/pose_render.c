@@ -56,7 +56,8 @@ static void usage(FILE *f)
           "                               LIST as 0,30,60 or 0-120:10\n"
           "  --map FILE                   the bridge mapping file for --source\n"
           "  --turntable N                N images around the model\n"
-          "  --compare                    one image: LBS | DQS | CoR side by side, same pose\n"
+          "  --compare                    one image: LBS | DQS | CoR side by side, same pose (of\n"
+          "                               --pose, or of one --frames frame of --source)\n"
           "Pose and look:\n"
           "  --pose JOINT=RX,RY,RZ        set a joint (degrees, XYZ order; repeatable)\n"
           "  --method lbs|dqs|cor         skinning method (default: cor when the rig has CoR data)\n"
@@ -218,8 +219,9 @@ static int parse_args(int argc, char **argv, options *o, char *err, size_t err_s
         return -1;
     }
     int modes = (o->source != NULL) + (o->turntable > 0) + o->compare;
-    if (modes > 1) {
-        snprintf(err, err_size, "choose one of --source, --turntable, --compare");
+    if (modes > 1 && !(modes == 2 && o->compare && o->source && o->frame_count == 1)) {
+        snprintf(err, err_size, "choose one of --source, --turntable, --compare (--compare takes --source with "
+                                "one frame)");
         return -1;
     }
     if (o->frames && !o->source) {
@@ -444,13 +446,15 @@ static int run(const options *o, summary *s, char *err, size_t err_size)
             snprintf(err, err_size, "out of memory");
         goto done;
     }
-    int many = motion || o->turntable;
+    int many = (motion && !o->compare) || o->turntable;
     const char *out = o->output ? o->output : many ? "render" : "pose.png";
     if (many && make_dir(out, err, err_size) < 0)
         goto done;
 
     if (o->compare) {
         static const pose_method methods[3] = {POSE_LBS, POSE_DQS, POSE_COR};
+        if (motion && ex_motion_set_frame(motion, sc.state, o->frames[0], err, err_size) < 0)
+            goto done;
         if (ex_image_init(&panel, 3 * o->width, o->height, bg8) < 0) {
             snprintf(err, err_size, "out of memory");
             goto done;

@@ -252,7 +252,7 @@ static void test_silhouette_follows_pose(void **state)
         free(im[i].px);
 }
 
-/* A real clip replayed through the bridge: the bar follows the CMU walk's right leg. */
+/* A real clip replayed through the bridge: the bar follows the CMU walk's right arm. */
 static void test_silhouette_follows_replay(void **state)
 {
     (void)state;
