@@ -204,52 +204,83 @@ static void closest_on_tri(const double p[3], double v[3][3], double out[3])
         out[k] = v[0][k] + ab[k] * sv + ac[k] * tw;
 }
 
-/* Target of vertex p: the nearest ray hit along +-d within reach, else the
- * closest surface point within reach. Returns 0 when nothing is in reach. */
-static int snap_target(const pp_mesh *m, const buckets *g, const double p[3], const double d[3],
+/* Visit the triangles of the buckets within `reach` of p. */
+#define FOR_TRIANGLES_NEAR(g, p, reach, tvar)                                                 \
+    double lo_[3], hi_[3];                                                                    \
+    for (int k_ = 0; k_ < 3; k_++) {                                                          \
+        lo_[k_] = (p)[k_] - (reach);                                                          \
+        hi_[k_] = (p)[k_] + (reach);                                                          \
+    }                                                                                         \
+    int a_[3], z_[3];                                                                         \
+    bucket_range((g), lo_, hi_, a_, z_);                                                      \
+    for (int bk_ = a_[2]; bk_ <= z_[2]; bk_++)                                                \
+        for (int bj_ = a_[1]; bj_ <= z_[1]; bj_++)                                            \
+            for (int bi_ = a_[0]; bi_ <= z_[0]; bi_++)                                        \
+                for (size_t q_ = (g)->start[(size_t)bi_ + (size_t)(g)->n[0] *                 \
+                                                ((size_t)bj_ + (size_t)(g)->n[1] * bk_)],      \
+                            e_ = (g)->start[(size_t)bi_ + (size_t)(g)->n[0] *                 \
+                                                ((size_t)bj_ + (size_t)(g)->n[1] * bk_) + 1];  \
+                     q_ < e_ && ((tvar) = (g)->tri[q_], 1); q_++)
+
+/* Signed distance along axis `axis` from p to the nearest surface hit within
+ * reach; 0 when the line misses. */
+static int axis_hit(const pp_mesh *m, const buckets *g, const double p[3], int axis, double reach,
+                    double *best)
+{
+    double d[3] = {0, 0, 0};
+    d[axis] = 1.0;
+    int have = 0;
+    uint32_t t;
+    *best = INFINITY;
+    FOR_TRIANGLES_NEAR(g, p, reach, t)
+    {
+        double v[3][3], s;
+        tri_points(m, t, v);
+        if (ray_tri(p, d, v, &s) && fabs(s) <= reach && fabs(s) < fabs(*best)) {
+            *best = s;
+            have = 1;
+        }
+    }
+    return have;
+}
+
+static int closest_point(const pp_mesh *m, const buckets *g, const double p[3], double reach,
+                         double out[3])
+{
+    double best = reach * reach;
+    int have = 0;
+    uint32_t t;
+    FOR_TRIANGLES_NEAR(g, p, reach, t)
+    {
+        double v[3][3], cp[3], r[3];
+        tri_points(m, t, v);
+        closest_on_tri(p, v, cp);
+        sub3(cp, p, r);
+        double d2 = dot3(r, r);
+        if (d2 < best) {
+            best = d2;
+            memcpy(out, cp, sizeof cp);
+            have = 1;
+        }
+    }
+    return have;
+}
+
+/* Target of a boundary vertex p whose staircase faces point along the axes
+ * set in dir: first each of those coordinates moves to the surface along its
+ * own axis (so a staircase corner offset by different amounts per axis lands
+ * on the surface's corner, and a box is recovered exactly), then the result
+ * goes to its closest surface point. Returns 0 when nothing is in reach. */
+static int snap_target(const pp_mesh *m, const buckets *g, const double p[3], const int8_t dir[3],
                        double reach, double out[3])
 {
-    double lo[3], hi[3];
+    double c[3] = {p[0], p[1], p[2]};
     for (int k = 0; k < 3; k++) {
-        lo[k] = p[k] - reach;
-        hi[k] = p[k] + reach;
+        double s;
+        if (dir[k] && axis_hit(m, g, p, k, reach, &s))
+            c[k] = p[k] + s;
     }
-    int a[3], z[3];
-    bucket_range(g, lo, hi, a, z);
-    double best_s = INFINITY, best_d2 = reach * reach;
-    int have_ray = 0, have_cp = 0;
-    double cp_best[3] = {0, 0, 0};
-    for (int k = a[2]; k <= z[2]; k++)
-        for (int j = a[1]; j <= z[1]; j++)
-            for (int i = a[0]; i <= z[0]; i++) {
-                size_t c = (size_t)i + (size_t)g->n[0] * ((size_t)j + (size_t)g->n[1] * k);
-                for (size_t q = g->start[c]; q < g->start[c + 1]; q++) {
-                    double v[3][3], s, cp[3], r[3];
-                    tri_points(m, g->tri[q], v);
-                    if (ray_tri(p, d, v, &s) && fabs(s) <= reach && fabs(s) < fabs(best_s)) {
-                        best_s = s;
-                        have_ray = 1;
-                    }
-                    closest_on_tri(p, v, cp);
-                    sub3(cp, p, r);
-                    double d2 = dot3(r, r);
-                    if (d2 < best_d2) {
-                        best_d2 = d2;
-                        memcpy(cp_best, cp, sizeof cp_best);
-                        have_cp = 1;
-                    }
-                }
-            }
-    if (have_ray) {
-        for (int k = 0; k < 3; k++)
-            out[k] = p[k] + best_s * d[k];
-        return 1;
-    }
-    if (have_cp) {
-        memcpy(out, cp_best, sizeof cp_best);
-        return 1;
-    }
-    return 0;
+    return closest_point(m, g, c, reach, out);
 }
 
 /* Shape quality of a tet with vertex `moved` at np: 6 sqrt(2) V / l_rms^3,
@@ -319,34 +350,59 @@ pose_status pp_tet_snap(pp_tetmesh *t, const pp_mesh *surface, const int8_t *dir
         for (size_t q = start[v]; q < start[v + 1]; q++)
             q0[q] = tet_shape(t->positions, t->tets + 4 * (size_t)inc[q], UINT32_MAX, NULL);
 
+    /* Targets from the staircase positions, then up to three sweeps: a move
+     * refused in one sweep (its neighbours not yet moved) often fits in the
+     * next. NaN marks a vertex that is done or has no target. */
+    float *target = malloc(3 * nv * sizeof *target);
+    if (!target) {
+        free(start);
+        free(inc);
+        free(q0);
+        free(g.start);
+        free(g.tri);
+        return POSE_ERR_OUT_OF_MEMORY;
+    }
+    size_t pending = 0;
     for (size_t v = 0; v < nv; v++) {
         const int8_t *dv = dir + 3 * v;
-        if (!(dv[0] | dv[1] | dv[2]))
-            continue;
         double p[3] = {t->positions[3 * v], t->positions[3 * v + 1], t->positions[3 * v + 2]};
-        double d[3] = {dv[0], dv[1], dv[2]};
-        double l = sqrt(dot3(d, d));
-        for (int k = 0; k < 3; k++)
-            d[k] /= l;
-        double target[3];
-        if (!snap_target(surface, &g, p, d, reach, target))
-            continue;
-        for (int tries = 0; tries < 3; tries++) {
-            double f = tries == 0 ? 1.0 : tries == 1 ? 0.5 : 0.25;
-            double np[3] = {p[0] + f * (target[0] - p[0]), p[1] + f * (target[1] - p[1]),
-                            p[2] + f * (target[2] - p[2])};
-            int ok = 1;
-            for (size_t q = start[v]; q < start[v + 1] && ok; q++)
-                ok = tet_shape(t->positions, t->tets + 4 * (size_t)inc[q], (uint32_t)v, np) >=
-                     fmin(PP_SNAP_MIN_SHAPE, q0[q]);
-            if (ok) {
+        double tg[3] = {0, 0, 0};
+        if ((dv[0] | dv[1] | dv[2]) && snap_target(surface, &g, p, dv, reach, tg)) {
+            for (int k = 0; k < 3; k++)
+                target[3 * v + k] = (float)tg[k];
+            pending++;
+        } else {
+            target[3 * v] = NAN;
+        }
+    }
+    for (int sweep = 0; sweep < 3 && pending; sweep++) {
+        for (size_t v = 0; v < nv; v++) {
+            if (isnan(target[3 * v]))
+                continue;
+            double p[3] = {t->positions[3 * v], t->positions[3 * v + 1], t->positions[3 * v + 2]};
+            for (int tries = 0; tries < 3; tries++) {
+                double f = tries == 0 ? 1.0 : tries == 1 ? 0.5 : 0.25;
+                double np[3];
+                for (int k = 0; k < 3; k++)
+                    np[k] = p[k] + f * ((double)target[3 * v + k] - p[k]);
+                int ok = 1;
+                for (size_t q = start[v]; q < start[v + 1] && ok; q++)
+                    ok = tet_shape(t->positions, t->tets + 4 * (size_t)inc[q], (uint32_t)v, np) >=
+                         fmin(PP_SNAP_MIN_SHAPE, q0[q]);
+                if (!ok)
+                    continue;
                 for (int k = 0; k < 3; k++)
                     t->positions[3 * v + k] = (float)np[k];
-                (*moved)++;
+                if (tries == 0) {
+                    target[3 * v] = NAN;
+                    pending--;
+                    (*moved)++;
+                }
                 break;
             }
         }
     }
+    free(target);
     free(start);
     free(inc);
     free(q0);

@@ -11,10 +11,11 @@
 #include <pose/pose.h>
 
 /**
- * Move each vertex v with dir[3v..3v+2] != 0 onto `surface`, along its
- * direction (the summed outward normals of its boundary faces, so box
- * corners and edges land on corners and edges) or, when that ray misses
- * within `reach`, to the closest surface point within `reach`. A move is
+ * Move each vertex v with dir[3v..3v+2] != 0 (the summed outward normals of
+ * its staircase boundary faces) onto `surface`: each coordinate whose axis
+ * is set in dir first moves along that axis to the surface, then the point
+ * goes to its closest surface point within `reach` (so staircase corners and
+ * edges land on the surface's corners and edges). A move is
  * halved up to twice and otherwise dropped when an incident tet would keep
  * less than 10 % of its volume, so no tet inverts. Returns the count moved.
  */

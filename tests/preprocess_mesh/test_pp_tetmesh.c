@@ -1,0 +1,259 @@
+/* SPDX-License-Identifier: Apache-2.0
+ *
+ * pp_tetrahedralize: bad inputs first, then a box (exact volume, positive
+ * tets, labels equal to the voxel labels, Kuhn quality), a cylinder with a
+ * bone, the size budget, and the TetGen backend on the same cases when it
+ * is built in.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include "mesh_io.h"
+#include "pp_assert.h"
+#include "pp_shapes.h"
+#include "tetmesh.h"
+#include "voxelize.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void test_bad_inputs(void **state)
+{
+    (void)state;
+    char err[256] = "";
+    pp_tetmesh t;
+    pp_voxels empty = {0};
+    assert_int_equal(pp_tetrahedralize(&empty, NULL, NULL, &t, NULL, err, sizeof err),
+                     POSE_ERR_INVALID_ARGUMENT);
+    uint16_t zeros[27] = {0};
+    pp_voxels none = {3, 3, 3, {0, 0, 0}, 0.01f, zeros};
+    assert_int_equal(pp_tetrahedralize(&none, NULL, NULL, &t, NULL, err, sizeof err),
+                     POSE_ERR_INVALID_DATA);
+    assert_non_null(strstr(err, "no body voxel"));
+    assert_null(t.tets);
+    pp_tet_backend b;
+    assert_int_equal(pp_tet_backend_parse("lattice", &b), 0);
+    assert_int_equal(b, PP_TET_LATTICE);
+    assert_int_equal(pp_tet_backend_parse("tetgen", &b), 0);
+    assert_int_equal(b, PP_TET_TETGEN);
+    assert_int_equal(pp_tet_backend_parse("delaunay", &b), -1);
+    assert_string_equal(pp_tet_backend_name(PP_TET_DEFAULT), "lattice");
+    assert_int_equal(pp_tet_backend_available(PP_TET_LATTICE), 1);
+#ifndef POSE_HAVE_TETGEN
+    uint16_t one[27] = {0};
+    one[13] = 1;
+    pp_voxels single = {3, 3, 3, {0, 0, 0}, 0.01f, one};
+    pp_tet_options o = {.backend = PP_TET_TETGEN};
+    assert_int_equal(pp_tetrahedralize(&single, NULL, &o, &t, NULL, err, sizeof err),
+                     POSE_ERR_UNSUPPORTED);
+    assert_non_null(strstr(err, "POSE_WITH_TETGEN"));
+#endif
+}
+
+/* Every tet positive, labels in range, summed volume returned. */
+static double check_mesh(const pp_tetmesh *t, uint16_t max_label)
+{
+    double vol = 0.0;
+    for (size_t i = 0; i < t->tet_count; i++) {
+        double v = pp_tet_volume(t, i);
+        assert_true(v > 0.0);
+        vol += v;
+        assert_true(t->labels[i] <= max_label);
+        for (int k = 0; k < 4; k++)
+            assert_true(t->tets[4 * i + k] < t->vertex_count);
+    }
+    return vol;
+}
+
+static void centroid(const pp_tetmesh *t, size_t i, float c[3])
+{
+    for (int k = 0; k < 3; k++) {
+        c[k] = 0.0f;
+        for (int q = 0; q < 4; q++)
+            c[k] += 0.25f * t->positions[3 * (size_t)t->tets[4 * i + q] + k];
+    }
+}
+
+static void box_case(pp_tet_backend backend)
+{
+    char err[256] = "";
+    float lo[3] = {0.013f, -0.021f, 0.1f}, hi[3] = {0.113f, 0.039f, 0.18f};
+    pp_mesh box;
+    shape_box(&box, lo, hi);
+    pp_voxels v;
+    assert_int_equal(pp_voxelize(&box, NULL, NULL, 0, 0.01f, &v, NULL, err, sizeof err), POSE_OK);
+    pp_tet_options o = {.backend = backend};
+    pp_tetmesh t;
+    pp_tet_quality q;
+    assert_int_equal(pp_tetrahedralize(&v, &box, &o, &t, &q, err, sizeof err), POSE_OK);
+    double exact = 0.1 * 0.06 * 0.08;
+    double vol = check_mesh(&t, 0);
+    if (backend == PP_TET_LATTICE) {
+        /* snapped onto the box: the staircase corners land on the box corners */
+        assert_near(vol, exact, 1e-6 * exact);
+    } else {
+        /* TetGen grades its tets down towards the boundary, so the quality
+         * guard refuses part of the half-voxel moves the x faces need here
+         * (voxel centres lie on them, the staircase is shifted by h / 2):
+         * within 1 %, not exact */
+        assert_near(vol, exact, 0.01 * exact);
+    }
+    assert_near(q.total_volume, vol, 1e-9);
+    assert_int_equal(q.inverted_count, 0);
+    assert_int_equal(q.tet_count, t.tet_count);
+    assert_true(q.min_volume > 0.0);
+    assert_true(q.min_dihedral_deg > 5.0);
+    pp_tetmesh_free(&t);
+    pp_tetmesh_free(&t);
+    pp_voxels_free(&v);
+    pp_mesh_free(&box);
+}
+
+static void test_box_lattice(void **state)
+{
+    (void)state;
+    box_case(PP_TET_LATTICE);
+}
+
+static void test_lattice_follows_voxels(void **state)
+{
+    (void)state;
+    char err[256] = "";
+    pp_mesh skin, bone;
+    shape_cylinder(&skin, 0, 0, 0.05f, 0.0f, 0.2f, 48);
+    shape_cylinder(&bone, 0, 0, 0.015f, 0.03f, 0.17f, 24);
+    uint16_t lab = 4;
+    pp_voxels v;
+    const float h = 0.005f;
+    assert_int_equal(pp_voxelize(&skin, &bone, &lab, 1, h, &v, NULL, err, sizeof err), POSE_OK);
+    size_t body = 0;
+    for (size_t i = 0; i < (size_t)v.nx * v.ny * v.nz; i++)
+        body += v.labels[i] != 0;
+
+    /* unsnapped: one cell per voxel, six congruent Kuhn tets each */
+    pp_tet_options o = {.no_snap = 1};
+    pp_tetmesh t;
+    pp_tet_quality q;
+    assert_int_equal(pp_tetrahedralize(&v, &skin, &o, &t, &q, err, sizeof err), POSE_OK);
+    assert_int_equal(t.tet_count, 6 * body);
+    double vol = check_mesh(&t, 5);
+    assert_near(vol, body * (double)h * h * h, 1e-9);
+    assert_near(q.min_dihedral_deg, 45.0, 1e-3);
+    assert_near(q.max_dihedral_deg, 90.0, 1e-3);
+    assert_near(q.max_radius_edge, sqrt(3.0) / 2.0, 1e-4);
+    assert_near(q.min_volume, h * h * h / 6.0, 1e-12);
+    size_t bone_tets = 0;
+    for (size_t i = 0; i < t.tet_count; i++) {
+        float c[3];
+        centroid(&t, i, c);
+        uint16_t l = pp_voxels_sample(&v, c);
+        assert_int_equal(t.labels[i], l - 1); /* voxel 1 -> 0, voxel 2 + j -> j + 1 */
+        bone_tets += t.labels[i] == 5;
+    }
+    assert_true(bone_tets > 0);
+    pp_tetmesh_free(&t);
+
+    /* snapped: volume of the cylinder (polygon prism), bone tets unchanged */
+    assert_int_equal(pp_tetrahedralize(&v, &skin, NULL, &t, &q, err, sizeof err), POSE_OK);
+    double prism = pp_mesh_volume(&skin);
+    vol = check_mesh(&t, 5);
+    assert_near(vol, prism, 0.01 * prism);
+    size_t bone_after = 0;
+    for (size_t i = 0; i < t.tet_count; i++)
+        bone_after += t.labels[i] == 5;
+    assert_int_equal(bone_after, bone_tets);
+    assert_true(q.min_dihedral_deg > 5.0);
+    pp_tetmesh_free(&t);
+    pp_voxels_free(&v);
+    pp_mesh_free(&bone);
+    pp_mesh_free(&skin);
+}
+
+static void test_lattice_budget(void **state)
+{
+    (void)state;
+    char err[256] = "";
+    float c[3] = {0, 0, 0};
+    pp_mesh s;
+    shape_sphere(&s, c, 0.1f, 3);
+    pp_voxels v;
+    assert_int_equal(pp_voxelize(&s, NULL, NULL, 0, 0.004f, &v, NULL, err, sizeof err), POSE_OK);
+    const size_t targets[] = {2000, 20000};
+    for (int i = 0; i < 2; i++) {
+        pp_tet_options o = {.target_vertices = targets[i]};
+        pp_tetmesh t;
+        assert_int_equal(pp_tetrahedralize(&v, &s, &o, &t, NULL, err, sizeof err), POSE_OK);
+        assert_near((double)t.vertex_count, (double)targets[i], 0.15 * targets[i]);
+        double vol = check_mesh(&t, 0);
+        assert_near(vol, pp_mesh_volume(&s), 0.03 * pp_mesh_volume(&s));
+        pp_tetmesh_free(&t);
+    }
+    pp_voxels_free(&v);
+    pp_mesh_free(&s);
+}
+
+#ifdef POSE_HAVE_TETGEN
+static void test_box_tetgen(void **state)
+{
+    (void)state;
+    box_case(PP_TET_TETGEN);
+}
+
+static void test_tetgen_labels(void **state)
+{
+    (void)state;
+    char err[256] = "";
+    pp_mesh skin, bone;
+    shape_cylinder(&skin, 0, 0, 0.05f, 0.0f, 0.2f, 48);
+    shape_cylinder(&bone, 0, 0, 0.015f, 0.03f, 0.17f, 24);
+    uint16_t lab = 4;
+    pp_voxels v;
+    const float h = 0.008f;
+    assert_int_equal(pp_voxelize(&skin, &bone, &lab, 1, h, &v, NULL, err, sizeof err), POSE_OK);
+    size_t body = 0, bone_vox = 0;
+    for (size_t i = 0; i < (size_t)v.nx * v.ny * v.nz; i++) {
+        body += v.labels[i] != 0;
+        bone_vox += v.labels[i] == PP_VOXEL_BONE0 + 4;
+    }
+    pp_tet_options o = {.backend = PP_TET_TETGEN, .no_snap = 1};
+    pp_tetmesh t;
+    pp_tet_quality q;
+    assert_int_equal(pp_tetrahedralize(&v, &skin, &o, &t, &q, err, sizeof err), POSE_OK);
+    /* unsnapped, the mesh fills the voxels exactly and conforms to the bone */
+    double vol = check_mesh(&t, 5), bone_vol = 0.0;
+    assert_near(vol, body * (double)h * h * h, 1e-6 * vol);
+    for (size_t i = 0; i < t.tet_count; i++) {
+        float c[3];
+        centroid(&t, i, c);
+        assert_int_equal(t.labels[i], pp_voxels_sample(&v, c) - 1);
+        if (t.labels[i] == 5)
+            bone_vol += pp_tet_volume(&t, i);
+    }
+    assert_near(bone_vol, bone_vox * (double)h * h * h, 1e-6 * bone_vol);
+    assert_true(q.max_radius_edge < 2.5); /* -q 1.414 holds away from tight corners */
+    pp_tetmesh_free(&t);
+    pp_voxels_free(&v);
+    pp_mesh_free(&bone);
+    pp_mesh_free(&skin);
+}
+#endif
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_bad_inputs),
+        cmocka_unit_test(test_box_lattice),
+        cmocka_unit_test(test_lattice_follows_voxels),
+        cmocka_unit_test(test_lattice_budget),
+#ifdef POSE_HAVE_TETGEN
+        cmocka_unit_test(test_box_tetgen),
+        cmocka_unit_test(test_tetgen_labels),
+#endif
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
