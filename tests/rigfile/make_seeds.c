@@ -1,0 +1,93 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* Writes the rig_load fuzz seeds: small valid rig files and damaged copies.
+ * usage: rigfile_make_seeds OUTPUT_DIR */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "pose/pose.h"
+#include "rig_bytes.h"
+#include "tiny_rig.h"
+
+static int save(const char *dir, const char *name, const uint8_t *data, size_t size)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "wb");
+    if (!f || fwrite(data, 1, size, f) != size || fclose(f) != 0) {
+        fprintf(stderr, "rigfile_make_seeds: cannot write %s\n", path);
+        return 1;
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 2) {
+        fprintf(stderr, "usage: rigfile_make_seeds OUTPUT_DIR\n");
+        return 2;
+    }
+    const char *dir = argv[1];
+    int bad = 0;
+    static const struct { const char *name; int cor, meta; } valid[] = {
+        {"valid_tiny_full.rig", 1, 1}, {"valid_tiny_no_cor.rig", 0, 1},
+        {"valid_tiny_minimal.rig", 0, 0},
+    };
+    uint8_t *img;
+    size_t size = 0;
+    for (size_t i = 0; i < sizeof valid / sizeof valid[0]; i++) {
+        tiny_rig t;
+        tiny_rig_init(&t, valid[i].cor, valid[i].meta);
+        void *data;
+        if (pose_rig_write_memory(&t.desc, NULL, &data, &size) != POSE_OK) {
+            fprintf(stderr, "rigfile_make_seeds: %s\n", pose_last_error());
+            return 1;
+        }
+        bad |= save(dir, valid[i].name, data, size);
+        free(data);
+    }
+    tiny_rig t;
+    tiny_rig_init(&t, 1, 1);
+    void *data;
+    if (pose_rig_write_memory(&t.desc, NULL, &data, &size) != POSE_OK)
+        return 1;
+    img = data; /* the damaged seeds start from the full rig */
+    uint8_t *d = malloc(size);
+    if (!d)
+        return 1;
+
+    memcpy(d, img, size);
+    bad |= save(dir, "bad_truncated_in_weights.rig", d, (size_t)rb_offset(d, SEC_WEIGHTS) + 40);
+
+    memcpy(d, img, size);
+    d[(size_t)rb_offset(d, SEC_TETMESH) + 100] ^= 0x40;
+    bad |= save(dir, "bad_crc_tetmesh.rig", d, size);
+
+    memcpy(d, img, size);
+    rb_put_u32(d + 8, 2);
+    rb_fix_crcs(d, size);
+    bad |= save(dir, "bad_future_version.rig", d, size);
+
+    memcpy(d, img, size);
+    {
+        float nan = NAN;
+        memcpy(d + rb_offset(d, SEC_WEIGHTS) + 64 + 128 + 4, &nan, 4);
+        rb_fix_crcs(d, size);
+    }
+    bad |= save(dir, "bad_nan_weight.rig", d, size);
+
+    memcpy(d, img, size);
+    rb_put_u32(d + rb_offset(d, SEC_SKELETON) + 64 + 3 * 64 + 4, 2); /* elbow's parent = wrist */
+    rb_fix_crcs(d, size);
+    bad |= save(dir, "bad_parent_after_child.rig", d, size);
+
+    memcpy(d, img, size);
+    rb_put_u32(d + rb_offset(d, SEC_TETMESH) + 64 + 192 + 8, 77); /* a tet vertex index */
+    rb_fix_crcs(d, size);
+    bad |= save(dir, "bad_tet_index.rig", d, size);
+
+    free(d);
+    free(img);
+    return bad;
+}
