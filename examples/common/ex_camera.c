@@ -35,10 +35,27 @@ void ex_camera_frame(ex_camera *cam, const float bmin[3], const float bmax[3], f
     cam->azimuth_deg = (ext[0] <= ext[1] ? 0.0f : 90.0f) + 25.0f;
     cam->elevation_deg = 15.0f;
     cam->fov_deg = 35.0f;
-    float half = 0.5f * cam->fov_deg * ex_deg;
-    float half_x = atanf(tanf(half) * (aspect > 0.0f ? aspect : 1.0f));
-    float fit = half < half_x ? half : half_x;
-    cam->distance = cam->radius / sinf(fit); /* the bounding sphere just fits */
+    ex_camera_fit(cam, bmin, bmax, aspect);
+}
+
+void ex_camera_fit(ex_camera *cam, const float bmin[3], const float bmax[3], float aspect)
+{
+    /* The nearest distance at which all 8 corners of the box are in view,
+     * corner by corner in the camera's frame (tighter than a bounding sphere). */
+    float v[16], tan_y = tanf(0.5f * cam->fov_deg * ex_deg), tan_x = tan_y * (aspect > 0.0f ? aspect : 1.0f);
+    float d = 0.0f;
+    cam->distance = 1.0f;
+    ex_camera_view(cam, v);
+    for (int c = 0; c < 8; c++) {
+        float p[3], q[3];
+        for (int i = 0; i < 3; i++)
+            p[i] = ((c >> i) & 1 ? bmax[i] : bmin[i]) - cam->target[i];
+        for (int r = 0; r < 3; r++) /* rotate into camera axes: right, up, towards the camera */
+            q[r] = v[r] * p[0] + v[4 + r] * p[1] + v[8 + r] * p[2];
+        float need = q[2] + fmaxf(fabsf(q[0]) / tan_x, fabsf(q[1]) / tan_y);
+        d = fmaxf(d, need);
+    }
+    cam->distance = fmaxf(d * 1.08f, cam->radius * 0.1f); /* a small margin around the model */
 }
 
 void ex_camera_eye(const ex_camera *cam, float eye[3])

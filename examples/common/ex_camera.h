@@ -23,6 +23,9 @@ typedef struct ex_camera {
  */
 void ex_camera_frame(ex_camera *cam, const float bmin[3], const float bmax[3], float aspect);
 
+/** Keep the direction, set the distance so the box just fits in view for `aspect`. */
+void ex_camera_fit(ex_camera *cam, const float bmin[3], const float bmax[3], float aspect);
+
 /** Camera position in model space. */
 void ex_camera_eye(const ex_camera *cam, float eye[3]);
 

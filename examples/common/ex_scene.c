@@ -84,21 +84,17 @@ void ex_scene_bounds(const ex_scene *sc, int posed, float bmin[3], float bmax[3]
         pose_tissue_info ti;
         if (pose_rig_tissue_info(sc->rig, (int)t, &ti) < 0)
             continue;
-        ex_grow(bmin, bmax, ti.rest_positions, ti.vertex_count);
-        if (posed) {
-            size_t n;
-            const float *p = pose_tissue_positions(sc->state, (int)t, &n);
-            if (p)
-                ex_grow(bmin, bmax, p, n);
-        }
+        size_t n = ti.vertex_count;
+        const float *p = posed ? pose_tissue_positions(sc->state, (int)t, &n) : ti.rest_positions;
+        if (p)
+            ex_grow(bmin, bmax, p, n);
     }
     /* The tet mesh is what is drawn in weight mode, and all there is without tissues. */
     if (!(bmin[0] <= bmax[0]) || sc->weight_joint >= 0) {
         pose_tet_info tet;
         if (pose_rig_tet_info(sc->rig, &tet) == POSE_OK) {
-            ex_grow(bmin, bmax, tet.rest_positions, tet.vertex_count);
-            size_t n;
-            const float *p = posed ? pose_tet_positions(sc->state, &n) : NULL;
+            size_t n = tet.vertex_count;
+            const float *p = posed ? pose_tet_positions(sc->state, &n) : tet.rest_positions;
             if (p)
                 ex_grow(bmin, bmax, p, n);
         }

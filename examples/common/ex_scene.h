@@ -44,8 +44,8 @@ void ex_scene_close(ex_scene *sc);
 int ex_scene_apply(ex_scene *sc, char *err, size_t err_size);
 
 /**
- * Bounds of the rest pose (all tissues, or the tet mesh when there are none),
- * grown to cover the posed tissues when `posed` is set.
+ * Bounds of the tissues (the tet mesh when there are none, or in weight
+ * mode): of the rest pose, or with `posed` of the current pose.
  */
 void ex_scene_bounds(const ex_scene *sc, int posed, float bmin[3], float bmax[3]);
 

@@ -334,7 +334,7 @@ static int make_dir(const char *dir, char *err, size_t err_size)
     return -1;
 }
 
-/* Camera for bounds bmin/bmax in an image of aspect w/h, then the user's overrides. */
+/* Camera for bounds bmin/bmax in an image of aspect w/h, with the user's direction and zoom. */
 static void setup_camera(ex_camera *cam, const options *o, const float bmin[3], const float bmax[3])
 {
     ex_camera_frame(cam, bmin, bmax, (float)o->width / (float)o->height);
@@ -342,6 +342,7 @@ static void setup_camera(ex_camera *cam, const options *o, const float bmin[3], 
         cam->azimuth_deg = (float)o->azimuth;
     if (o->have_elevation)
         cam->elevation_deg = (float)o->elevation;
+    ex_camera_fit(cam, bmin, bmax, (float)o->width / (float)o->height);
     cam->distance /= (float)o->zoom;
 }
 
@@ -431,7 +432,10 @@ static int run(const options *o, summary *s, char *err, size_t err_size)
             if (ex_motion_set_frame(motion, sc.state, o->frames[i], err, err_size) < 0 ||
                 ex_scene_apply(&sc, err, err_size) < 0)
                 goto done;
-            grow_bounds(&sc, bmin, bmax);
+            if (i == 0) /* the frames alone, not the pose before them */
+                ex_scene_bounds(&sc, 1, bmin, bmax);
+            else
+                grow_bounds(&sc, bmin, bmax);
         }
     if (o->compare && !o->fit_rest)
         for (int m = 0; m < 3; m++)

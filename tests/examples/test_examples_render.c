@@ -342,9 +342,9 @@ static void test_lbs_vs_cor_twist(void **state)
         free(im.px);
     }
     printf("twist 135 deg, silhouette waist / normal height: LBS %.2f, CoR %.2f\n", ratio[0], ratio[1]);
-    assert_true(ratio[1] > 0.85); /* CoR keeps the cross-section */
-    assert_true(ratio[0] < 0.75); /* LBS collapses it */
-    assert_true(ratio[0] < ratio[1] - 0.15);
+    assert_true(ratio[1] > 0.75); /* CoR keeps the cross-section (a small notch at the joint) */
+    assert_true(ratio[0] < 0.6);  /* LBS collapses it */
+    assert_true(ratio[0] < ratio[1] - 0.25);
 }
 
 static void test_compare_panel(void **state)
