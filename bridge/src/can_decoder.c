@@ -517,9 +517,9 @@ void pb_can_decoder_add_dropped(pb_can_decoder *d, uint64_t n)
     }
 }
 
-void pb_can_decoder_add_bad_line(pb_can_decoder *d, const char *what)
+void pb_can_decoder_add_bad_lines(pb_can_decoder *d, uint64_t n, const char *what)
 {
-    d->stats.bad_lines++;
+    d->stats.bad_lines += n;
     snprintf(d->notice, sizeof d->notice, "malformed log line: %s", what);
 }
 

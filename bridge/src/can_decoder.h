@@ -109,7 +109,8 @@ void pb_can_decoder_tick(pb_can_decoder *dec, int64_t now_ns);
 
 /** Count frames the receiver lost (drop counters, overflow). */
 void pb_can_decoder_add_dropped(pb_can_decoder *dec, uint64_t n);
-void pb_can_decoder_add_bad_line(pb_can_decoder *dec, const char *what);
+/** Count n malformed log lines; what describes the latest. */
+void pb_can_decoder_add_bad_lines(pb_can_decoder *dec, uint64_t n, const char *what);
 
 /**
  * The bus's health as a source state: FAULT when error-passive or bus-off,

@@ -42,8 +42,8 @@ static int fetch(can_replay *s)
 {
     int r = pb_candump_next(&s->reader, &s->pending);
     if (s->reader.bad_lines != s->bad_seen) {
+        pb_can_decoder_add_bad_lines(s->core.dec, s->reader.bad_lines - s->bad_seen, s->reader.last_error);
         s->bad_seen = s->reader.bad_lines;
-        pb_can_decoder_add_bad_line(s->core.dec, s->reader.last_error);
         pb_can_source_core_report(&s->core);
     }
     if (r != 1)

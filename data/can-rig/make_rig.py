@@ -319,7 +319,8 @@ def main():
     ei = 0
     for k in range(1, int(DURATION / 0.05) + 1):
         T = k * 0.05
-        while ei < len(events) and events[ei][0] <= T:
+        # compare in whole microseconds, as the log's stamps are written
+        while ei < len(events) and int(round(events[ei][0] * 1e6)) <= k * 50000:
             latest.update(events[ei][3])
             ei += 1
         rows.append([f"{T:.3f}"] + [f"{latest[c]:.6f}" if c in latest else "" for c in channels])
