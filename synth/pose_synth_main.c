@@ -31,6 +31,22 @@ static void usage(FILE *f)
           f);
 }
 
+/* Writes s as a JSON string literal. */
+static void json_string(const char *s)
+{
+    putchar('"');
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            printf("\\%c", c);
+        else if (c < 0x20)
+            printf("\\u%04x", c);
+        else
+            putchar(c);
+    }
+    putchar('"');
+}
+
 static double now(void)
 {
     struct timespec ts;
@@ -96,6 +112,10 @@ int main(int argc, char **argv)
         usage(stderr);
         return 2;
     }
+    if ((bones && strcmp(kind, "bar") != 0) || (tets && strcmp(kind, "body") != 0)) {
+        fprintf(stderr, "pose-synth: --bones applies to bar, --tets to body\n");
+        return 2;
+    }
     int progress = isatty(STDERR_FILENO);
     if (progress)
         fprintf(stderr, "pose-synth: [1/2] generating %s rig...\n", kind);
@@ -141,12 +161,16 @@ int main(int argc, char **argv)
     long long bytes = stat(path, &sb) == 0 ? (long long)sb.st_size : -1;
     const char *cm = cor_name(pose_synth_cor(rig));
     if (json) {
-        printf("{\"kind\": \"%s\", \"file\": \"%s\", \"bytes\": %lld, \"joints\": %zu, "
-               "\"tet_vertices\": %zu, \"tets\": %zu, \"influences\": %u, \"tissues\": %zu, "
-               "\"tissue_vertices\": %zu, \"tissue_triangles\": %zu, \"cor\": \"%s\", "
-               "\"cor_approximate\": %s, \"generate_seconds\": %.3f, \"write_seconds\": %.3f}\n",
-               kind, path, bytes, d->joint_count, d->tet_vertex_count, d->tet_count,
-               d->influences, d->tissue_count, tv, tt, cm,
+        printf("{\"kind\": ");
+        json_string(kind);
+        printf(", \"file\": ");
+        json_string(path);
+        printf(", \"bytes\": %lld, \"joints\": %zu, \"tet_vertices\": %zu, \"tets\": %zu, "
+               "\"influences\": %u, \"tissues\": %zu, \"tissue_vertices\": %zu, "
+               "\"tissue_triangles\": %zu, \"cor\": \"%s\", \"cor_approximate\": %s, "
+               "\"generate_seconds\": %.3f, \"write_seconds\": %.3f}\n",
+               bytes, d->joint_count, d->tet_vertex_count, d->tet_count, d->influences,
+               d->tissue_count, tv, tt, cm,
                pose_synth_cor(rig) == POSE_SYNTH_COR_CLUSTERED ? "true" : "false", t1 - t0,
                t2 - t1);
     } else {
