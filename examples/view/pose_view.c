@@ -39,9 +39,10 @@ static void usage(FILE *f)
           "  --source FILE           drive the pose from a source through the bridge\n"
           "                          (BVH, ASF/AMC, HID or CAN recording, device)\n"
           "  --map FILE              the bridge mapping file for --source\n"
-          "  --method lbs|dqs|cor    initial skinning method\n"
+          "  --method lbs|dqs|cor    initial skinning method (default: cor when the rig has CoR data)\n"
           "  --pose JOINT=RX,RY,RZ   initial joint angles (degrees; repeatable)\n"
           "  --size WxH              window size (default 1280x800)\n"
+          "  --quit-after N          close after N frames and print the frame rate (smoke tests)\n"
           "  -h, --help              this text\n"
           "Keys: mouse drag orbit, right drag pan, wheel zoom | 1 LBS 2 DQS 3 CoR | S skin\n"
           "  (translucent/opaque/hidden) B bones M muscles O organs T other | W weights of the\n"
@@ -242,6 +243,7 @@ int main(int argc, char **argv)
 {
     const char *rig = NULL, *source = NULL, *map = NULL, *poses[64];
     int npose = 0, method = -1, width = 1280, height = 800;
+    long quit_after = 0;
     char err[1024] = "";
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
@@ -272,6 +274,8 @@ int main(int argc, char **argv)
             ;
         else if (!strcmp(a, "--size") && ex_parse_size(a, val, &width, &height, err, sizeof err) == 0)
             ;
+        else if (!strcmp(a, "--quit-after") && ex_parse_long(a, val, 1, 1000000, &quit_after, err, sizeof err) == 0)
+            ;
         else {
             fprintf(stderr, "pose-view: bad option '%s %s' (see --help)%s%s\n", a, val, err[0] ? ": " : "", err);
             return 2;
@@ -297,7 +301,11 @@ int main(int argc, char **argv)
         snprintf(err, sizeof err, "out of memory");
         goto done;
     }
-    if (method >= 0 && pose_set_method(v.sc.state, (pose_method)method) < 0) {
+    if (method < 0) { /* like pose-render: CoR when the rig has the data */
+        pose_tet_info tet;
+        method = pose_rig_tet_info(v.sc.rig, &tet) == POSE_OK && tet.cor ? POSE_COR : POSE_LBS;
+    }
+    if (pose_set_method(v.sc.state, (pose_method)method) < 0) {
         snprintf(err, sizeof err, "--method: %s", pose_last_error());
         goto done;
     }
@@ -346,9 +354,10 @@ int main(int argc, char **argv)
         ex_camera_frame(&v.cam, bmin, bmax, (float)width / (float)height);
     }
     v.joint = pose_rig_joint_count(v.sc.rig) > 1 ? 1 : 0;
-    double last = glfwGetTime(), fps_t = last;
+    double last = glfwGetTime(), fps_t = last, start = last, apply_sum = 0.0;
     int frames = 0;
-    while (!glfwWindowShouldClose(win)) {
+    long total = 0;
+    while (!glfwWindowShouldClose(win) && (!quit_after || total < quit_after)) {
         double now = glfwGetTime();
         if (v.motion && v.playing) {
             seek(&v, v.play_t + (now - last) * v.speed);
@@ -372,12 +381,19 @@ int main(int argc, char **argv)
         glfwSwapBuffers(win);
         glfwPollEvents();
         frames++;
+        total++;
+        apply_sum += v.sc.last_apply_ms;
         if (now - fps_t >= 0.5) {
             v.fps = frames / (now - fps_t);
             frames = 0;
             fps_t = now;
         }
     }
+    if (quit_after && total > 0)
+        printf("pose-view: %ld frames in %.2f s (%.1f fps), mean pose_apply %.3f ms, method %s%s%s\n", total,
+               glfwGetTime() - start, (double)total / (glfwGetTime() - start), apply_sum / (double)total,
+               ex_method_name(pose_get_method(v.sc.state)), v.motion ? ", source " : "",
+               v.motion ? ex_motion_status(v.motion) : "");
     rc = 0;
 done:
     if (rc)

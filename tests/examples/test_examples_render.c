@@ -176,6 +176,24 @@ static void test_view_without_display(void **state)
     assert_non_null(strstr(slurp(log), "none.rig"));
 }
 
+/* With a virtual X server (xvfb-run), the viewer opens, draws and closes cleanly. */
+static void test_view_under_xvfb(void **state)
+{
+    (void)state;
+    char log[2400];
+    snprintf(log, sizeof log, "%s/xvfb.log", tmp);
+    if (!strcmp(view_bin, "-") || run(log, "command -v xvfb-run") != 0)
+        skip(); /* no viewer, or no Xvfb (Debian package xvfb) */
+    assert_int_equal(run(log, "xvfb-run -a -s '-screen 0 640x480x24' '%s' '%s' --size 320x240 --quit-after 5 "
+                              "--pose joint2=0,45,0",
+                         view_bin, bar),
+                     0);
+    const char *out = slurp(log);
+    printf("%s", out);
+    assert_non_null(strstr(out, "pose-view: 5 frames in"));
+    assert_non_null(strstr(out, "method CoR"));
+}
+
 /* ---------------------------------------------------------------- images */
 
 static void test_rest_image_not_blank(void **state)
@@ -469,6 +487,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_bad_options),
         cmocka_unit_test(test_broken_source),
         cmocka_unit_test(test_view_without_display),
+        cmocka_unit_test(test_view_under_xvfb),
         cmocka_unit_test(test_rest_image_not_blank),
         cmocka_unit_test(test_silhouette_follows_pose),
         cmocka_unit_test(test_silhouette_follows_replay),
