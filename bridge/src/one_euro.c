@@ -60,10 +60,12 @@ void pb_one_euro_quat_step(pb_one_euro_quat *f, double q[4], double te)
         return;
     }
     /* angle of the rotation from the previous estimate to the sample (rad) */
-    double d = fabs(pb_quat_dot(f->q, q));
-    if (d > 1.0)
-        d = 1.0;
-    double speed = 2.0 * acos(d) / te;
+    double s = pb_quat_dot(f->q, q) < 0.0 ? -1.0 : 1.0, dm = 0.0, dp = 0.0;
+    for (int i = 0; i < 4; i++) {
+        dm += (q[i] - s * f->q[i]) * (q[i] - s * f->q[i]);
+        dp += (q[i] + s * f->q[i]) * (q[i] + s * f->q[i]);
+    }
+    double speed = 4.0 * atan2(sqrt(dm), sqrt(dp)) / te; /* rotation angle / te */
     double ad = pb_one_euro_alpha(f->p.d_cutoff, te);
     f->dx = ad * speed + (1.0 - ad) * f->dx;
     double fc = f->p.min_cutoff + f->p.beta * f->dx;

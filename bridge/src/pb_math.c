@@ -19,13 +19,11 @@ void pb_quat_to_euler(const double q[4], pose_euler_order order, double deg[3])
     int a = ax[0], b = ax[1], c = ax[2];
     /* parity: +1 for cyclic (x,y,z), (y,z,x), (z,x,y) */
     double p = ((b - a + 3) % 3 == 1) ? 1.0 : -1.0;
-    double sb = p * m[a][c];
-    if (sb > 1.0)
-        sb = 1.0;
-    if (sb < -1.0)
-        sb = -1.0;
-    double ang_a, ang_b = asin(sb), ang_c;
-    if (fabs(sb) < 0.9999999) {
+    /* the middle angle from atan2 (not asin), so it stays accurate near
+     * +-90 degrees where asin is ill-conditioned */
+    double sb = p * m[a][c], cb = sqrt(m[a][a] * m[a][a] + m[a][b] * m[a][b]);
+    double ang_a, ang_b = atan2(sb, cb), ang_c;
+    if (cb > 1e-12) {
         ang_a = atan2(-p * m[b][c], m[c][c]);
         ang_c = atan2(-p * m[a][b], m[a][a]);
     } else { /* gimbal lock: put everything into the outer angle */

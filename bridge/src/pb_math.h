@@ -99,17 +99,19 @@ static inline double pb_quat_dot(const double a[4], const double b[4])
 /** Shortest-path spherical interpolation, t in [0, 1]. */
 static inline void pb_quat_slerp(const double a[4], const double b[4], double t, double out[4])
 {
-    double d = pb_quat_dot(a, b), s = 1.0;
-    if (d < 0.0) {
-        d = -d;
-        s = -1.0;
+    double s = pb_quat_dot(a, b) < 0.0 ? -1.0 : 1.0, dm = 0.0, dp = 0.0;
+    for (int i = 0; i < 4; i++) {
+        dm += (a[i] - s * b[i]) * (a[i] - s * b[i]);
+        dp += (a[i] + s * b[i]) * (a[i] + s * b[i]);
     }
-    double wa, wb;
-    if (d > 0.9995) { /* nearly parallel: lerp is exact enough and avoids 0/0 */
+    /* angle between the 4-vectors, accurate also when tiny (acos of a dot
+     * product near 1 is not) */
+    double th = 2.0 * atan2(sqrt(dm), sqrt(dp)), wa, wb;
+    if (th < 1e-9) {
         wa = 1.0 - t;
         wb = t;
     } else {
-        double th = acos(d), sn = sin(th);
+        double sn = sin(th);
         wa = sin((1.0 - t) * th) / sn;
         wb = sin(t * th) / sn;
     }

@@ -1,3 +1,192 @@
-/* SPDX-License-Identifier: Apache-2.0 */
-int main(void);
-int main(void) { return 0; }
+/* SPDX-License-Identifier: Apache-2.0
+ * Mapping files: invalid input first (syntax, fields, unknown joints and
+ * channels), then the scalar-channel stages (calibration, inversion,
+ * deadband, limits, Euler composition) with hand-computed values. */
+#include "bridge_test.h"
+#include "mapping.h"
+#include "pb_math.h"
+
+static void expect_parse_error(const char *json, const char *fragment)
+{
+    pb_mapping *m = (pb_mapping *)1;
+    pb_error err;
+    assert_int_equal(pb_mapping_parse(json, strlen(json), "m.json", &m, &err), POSE_ERR_FORMAT);
+    assert_null(m);
+    if (!strstr(err.message, fragment))
+        fail_msg("message '%s' lacks '%s'", err.message, fragment);
+}
+
+static void test_bad_mapping_files(void **state)
+{
+    (void)state;
+    expect_parse_error("{\n\"joints\": {\n\"a\": \"b\",\n}\n}", "m.json:4: invalid JSON");
+    expect_parse_error("[1, 2]", "expected a JSON object at the top");
+    expect_parse_error("{\"joints\": {\"knee\": 3}}", "joints.knee: expected a clip joint name");
+    expect_parse_error("{\"joints\": [\"knee\"]}", "joints: expected an object");
+    expect_parse_error("{\"scale\": -1}", "scale: expected a positive number");
+    expect_parse_error("{\"root_motion\": \"up\"}", "root_motion: expected");
+    expect_parse_error("{\"reference\": 1.5}", "reference: expected \"zero\" or a frame number");
+    expect_parse_error("{\"source_axes\": {\"up\": \"+y\", \"forward\": \"-y\"}, \"rig_axes\": {\"up\": \"+z\", \"forward\": \"+x\"}}",
+                       "source_axes: expected");
+    expect_parse_error("{\"source_axes\": {\"up\": \"+y\", \"forward\": \"+z\"}}", "rig_axes: expected");
+    expect_parse_error("{\"filter\": {\"beta\": -1}}", "filter.beta: expected a non-negative number");
+    expect_parse_error("{\"channels\": [{\"channel\": \"a\", \"joint\": \"j\", \"axis\": \"w\"}]}",
+                       "channels[0].axis: expected");
+    expect_parse_error("{\"channels\": [{\"joint\": \"j\", \"axis\": \"x\"}]}", "channels[0]: needs \"channel\" or \"usage\"");
+    expect_parse_error("{\"channels\": [{\"channel\": \"a\", \"joint\": \"j\", \"axis\": \"x\", \"calibration\": "
+                       "{\"raw\": [1, 1], \"deg\": [0, 90]}}]}",
+                       "channels[0].calibration.raw: the two points are equal");
+    expect_parse_error("{\"channels\": [{\"channel\": \"a\", \"joint\": \"j\", \"axis\": \"x\", \"limits\": [10, -10]}]}",
+                       "channels[0].limits: min is above max");
+    expect_parse_error("{\"channels\": [{\"usage\": \"0x1zz\", \"joint\": \"j\", \"axis\": \"x\"}]}",
+                       "channels[0].usage: expected");
+    expect_parse_error("{\"channels\": [{\"channel\": \"a\", \"joint\": \"j\", \"axis\": \"x\", \"order\": \"XXY\"}]}",
+                       "channels[0].order: expected");
+    expect_parse_error("{\"joints\": {\"a\": \"b\", \"a\": \"c\"}}", "joints.a: rig joint mapped twice");
+    pb_mapping *m;
+    pb_error err;
+    assert_int_equal(pb_mapping_load("/nonexistent/map.json", &m, &err), POSE_ERR_IO);
+    assert_non_null(strstr(err.message, "/nonexistent/map.json"));
+}
+
+static const char *BVH = "HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 0\nCHANNELS 6 Xposition Yposition Zposition "
+                         "Zrotation Xrotation Yrotation\nJOINT Arm\n{\nOFFSET 1 0 0\nCHANNELS 3 Zrotation Xrotation "
+                         "Yrotation\nEnd Site\n{\nOFFSET 1 0 0\n}\n}\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\n"
+                         "0 0 0 0 0 0 0 0 0\n";
+
+static void test_unknown_joints(void **state)
+{
+    (void)state;
+    pb_clip *clip;
+    pb_rig_skel *rig;
+    pb_error err;
+    assert_int_equal(pb_bvh_parse(BVH, strlen(BVH), "t.bvh", &clip, &err), POSE_OK);
+    assert_int_equal(pb_rig_skel_from_clip(clip, 1.0, &rig, &err), POSE_OK);
+    const char *j1 = "{\"joints\": {\"elbow\": \"Arm\"}}";
+    const char *j2 = "{\"joints\": {\"Arm\": \"ForeArm\"}}";
+    pb_mapping *m;
+    pb_retarget *r = (pb_retarget *)1;
+    assert_int_equal(pb_mapping_parse(j1, strlen(j1), "m.json", &m, &err), POSE_OK);
+    assert_int_equal(pb_retarget_create(m, clip, rig, &r, &err), POSE_ERR_NOT_FOUND);
+    assert_null(r);
+    assert_string_equal(err.message, "m.json: joints.elbow: the rig has no joint 'elbow'");
+    pb_mapping_free(m);
+    assert_int_equal(pb_mapping_parse(j2, strlen(j2), "m.json", &m, &err), POSE_OK);
+    assert_int_equal(pb_retarget_create(m, clip, rig, &r, &err), POSE_ERR_NOT_FOUND);
+    assert_string_equal(err.message, "m.json: joints.Arm: the clip t.bvh has no joint 'ForeArm'");
+    pb_mapping_free(m);
+    const char *j3 = "{\"joints\": {\"Arm\": \"Arm\"}, \"reference\": 5}";
+    assert_int_equal(pb_mapping_parse(j3, strlen(j3), "m.json", &m, &err), POSE_OK);
+    assert_int_equal(pb_retarget_create(m, clip, rig, &r, &err), POSE_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(err.message, "reference: frame 5 is beyond the clip's 1 frames"));
+    pb_mapping_free(m);
+    /* channels: unknown channel, unknown usage, unknown joint */
+    pb_channel ch[2] = {{.name = "A", .usage = 0x00010030}, {.name = "B", .usage = 0x00010030}};
+    pb_chanmap *cm;
+    const char *c1 = "{\"channels\": [{\"channel\": \"C\", \"joint\": \"Arm\", \"axis\": \"x\"}]}";
+    const char *c2 = "{\"channels\": [{\"usage\": \"0x00010030\", \"index\": 2, \"joint\": \"Arm\", \"axis\": \"x\"}]}";
+    const char *c3 = "{\"channels\": [{\"channel\": \"A\", \"joint\": \"Leg\", \"axis\": \"x\"}]}";
+    const char *c[3] = {c1, c2, c3};
+    const char *want[3] = {"m.json: channels[0].channel: the source has no channel 'C'",
+                           "m.json: channels[0].usage: the source has no channel #2 with usage 0x00010030",
+                           "m.json: channels[0].joint: the rig has no joint 'Leg'"};
+    for (int i = 0; i < 3; i++) {
+        assert_int_equal(pb_mapping_parse(c[i], strlen(c[i]), "m.json", &m, &err), POSE_OK);
+        assert_int_equal(pb_chanmap_create(m, ch, 2, rig, &cm, &err), POSE_ERR_NOT_FOUND);
+        assert_string_equal(err.message, want[i]);
+        pb_mapping_free(m);
+    }
+    pb_rig_skel_free(rig);
+    pb_clip_free(clip);
+}
+
+static void test_channel_stages(void **state)
+{
+    (void)state;
+    pb_clip *clip;
+    pb_rig_skel *rig;
+    pb_error err;
+    assert_int_equal(pb_bvh_parse(BVH, strlen(BVH), "t.bvh", &clip, &err), POSE_OK);
+    assert_int_equal(pb_rig_skel_from_clip(clip, 1.0, &rig, &err), POSE_OK);
+    const char *js = "{\"channels\": ["
+                     "{\"channel\": \"A\", \"joint\": \"Arm\", \"axis\": \"x\", \"order\": \"ZXY\","
+                     " \"calibration\": {\"raw\": [100, 300], \"deg\": [-90, 90]}, \"deadband\": 2, \"limits\": [-60, 60]},"
+                     "{\"usage\": 65585, \"joint\": \"Arm\", \"axis\": \"z\", \"order\": \"ZXY\","
+                     " \"calibration\": {\"offset\": -512, \"scale\": 0.5}, \"invert\": true}]}";
+    pb_mapping *m;
+    assert_int_equal(pb_mapping_parse(js, strlen(js), "m.json", &m, &err), POSE_OK);
+    /* two-point: 100 -> -90, 300 -> 90, so 150 -> -45 */
+    assert_near(pb_map_channel_transform(&m->channels[0], 150), -45.0, 1e-12);
+    /* linear then inverted: -((700 - 512) * 0.5) = -94 */
+    assert_near(pb_map_channel_transform(&m->channels[1], 700), -94.0, 1e-12);
+    pb_channel ch[2] = {{.name = "A"}, {.name = "Y", .usage = 0x00010031}};
+    pb_chanmap *cm;
+    if (pb_chanmap_create(m, ch, 2, rig, &cm, &err) != POSE_OK)
+        fail_msg("%s", err.message);
+    uint32_t idx[2] = {0, 1};
+    double v[2] = {150, 532};
+    pb_update u = {.t_ns = 0, .count = 2, .channels = idx, .values = v};
+    pb_chanmap_update(cm, &u);
+    assert_near(pb_chanmap_value(cm, 0), -45.0, 1e-12);
+    assert_near(pb_chanmap_value(cm, 1), -10.0, 1e-12);
+    /* deadband 2 deg: 151 -> -44.1 stays -45; 153 -> -42.3 moves */
+    v[0] = 151;
+    u.t_ns += 10000000;
+    pb_chanmap_update(cm, &u);
+    assert_near(pb_chanmap_value(cm, 0), -45.0, 1e-12);
+    v[0] = 153;
+    pb_chanmap_update(cm, &u);
+    assert_near(pb_chanmap_value(cm, 0), -42.3, 1e-12);
+    /* limits: 280 -> 72 clamps to 60; a NaN sample is dropped */
+    v[0] = 280;
+    pb_chanmap_update(cm, &u);
+    assert_near(pb_chanmap_value(cm, 0), 60.0, 1e-12);
+    v[0] = NAN;
+    pb_chanmap_update(cm, &u);
+    assert_near(pb_chanmap_value(cm, 0), 60.0, 1e-12);
+    /* the joint: x = 60, z = -10 composed in ZXY */
+    pb_pose pose;
+    assert_int_equal(pb_pose_init(&pose, rig->joint_count), 0);
+    pb_chanmap_pose(cm, &pose);
+    double q[4], deg[3] = {60, 0, -10};
+    pb_quat_from_euler(deg, POSE_EULER_ZXY, q);
+    int arm = pb_rig_skel_find(rig, "Arm");
+    assert_true(pose.active[arm]);
+    assert_false(pose.active[0]);
+    for (int k = 0; k < 4; k++)
+        assert_near(pose.q[arm][k], q[k], 1e-6);
+    pb_pose_free(&pose);
+    pb_chanmap_free(cm);
+    pb_mapping_free(m);
+    pb_rig_skel_free(rig);
+    pb_clip_free(clip);
+}
+
+static void test_shipped_maps_parse(void **state)
+{
+    (void)state;
+    const char *maps[] = {"cmu131_bvh_to_full_body.json", "cmu_cgspeed_bvh_to_full_body.json",
+                          "cmu_asf_to_full_body.json", "cmu131_arm_to_bar.json"};
+    for (size_t i = 0; i < sizeof maps / sizeof maps[0]; i++) {
+        char p[1024];
+        bt_path(p, sizeof p, "POSE_DATA_DIR", "../bridge/maps/");
+        strncat(p, maps[i], sizeof p - strlen(p) - 1);
+        pb_mapping *m;
+        pb_error err;
+        if (pb_mapping_load(p, &m, &err) != POSE_OK)
+            fail_msg("%s", err.message);
+        assert_true(m->joint_count >= 4);
+        pb_mapping_free(m);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_bad_mapping_files),
+        cmocka_unit_test(test_unknown_joints),
+        cmocka_unit_test(test_channel_stages),
+        cmocka_unit_test(test_shipped_maps_parse),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
