@@ -7,10 +7,12 @@
 #include <stdint.h>
 
 /**
- * Tissue vertices in the compact form built at rig load. A vertex lies in a
- * tet (v0..v3) with barycentric coordinates b0..b3; the vertices are ordered
- * so that b0 is the largest (a tissue vertex sitting on a tet vertex then
- * follows it exactly) and only b1..b3 are stored: p = v0 + sum bi (vi - v0).
+ * Tissue vertices in the blocked form built at rig load (8 lanes per block,
+ * fields lane after lane, as pose__skin_mesh). A vertex lies in a tet
+ * (v0..v3) with barycentric coordinates b0..b3; the tet's vertices are
+ * ordered so that b0 is the largest (a tissue vertex sitting on a tet vertex
+ * then follows it exactly) and only b1..b3 are stored:
+ * p = v0 + sum bi (vi - v0).
  *
  * Normals use the tet's affine map F = D' D^-1 (D = [v1-v0 v2-v0 v3-v0]):
  * n' ~ F^-T n = D'^-T (D^T n) = cof(D') (D^T n) / det D'. The constant part
@@ -19,13 +21,20 @@
  */
 typedef struct pose__transfer_mesh {
     size_t vertex_count;
-    const uint32_t *tet_vertices; /**< 4 * n tet vertex indices, v0 first */
-    const float *bary;            /**< 3 * n: b1, b2, b3 */
-    const int16_t *normal_key;    /**< 3 * n, see above; 0 0 0 = no normal */
+    size_t block_count;           /**< ceil(vertex_count / 8) */
+    const uint32_t *tet_vertices; /**< block_count * 32: [block][corner][lane], v0 first */
+    const float *bary;            /**< block_count * 24: b1[8] b2[8] b3[8] */
+    const int16_t *normal_key;    /**< block_count * 24, see above; 0 0 0 = no normal */
 } pose__transfer_mesh;
 
-/** Positions (and normals when nrm != NULL) of vertices [begin, end). */
+/** Positions (and normals when nrm != NULL) of blocks [begin, end); xyz
+ *  interleaved at pos/nrm + 3 * vertex; padding lanes are not written. */
 void pose__transfer(const pose__transfer_mesh *mesh, const float *tet_positions, size_t begin,
                     size_t end, float *pos, float *nrm);
+
+/** Bytes pose__transfer streams per call over the whole mesh, counting the
+ *  deformed tet vertices once (for benchmarks). */
+size_t pose__transfer_bytes(const pose__transfer_mesh *mesh, size_t tet_vertex_count,
+                            int normals);
 
 #endif /* POSE_RT_TRANSFER_H */

@@ -111,46 +111,84 @@ pose_status pose__rig_prepare(pose_rig *rig)
 {
     rig->rt = NULL;
     const size_t nv = rig->tet_vertex_count, K = rig->influences, nj = rig->joint_count;
+    const size_t B = POSE__BLOCK, nb = (nv + B - 1) / B;
     size_t total = 0;
     for (size_t t = 0; t < rig->tissue_count; t++)
         total += rig->tissues[t].vertex_count;
+    const size_t tb = (total + B - 1) / B;
     const int narrow = nj <= 256;
 
-    /* One block: header, joints, weights, tissue arrays, rest frames. */
-    size_t off_rt = 0;
-    size_t off_joints = align64(sizeof(struct pose__rig_runtime));
-    size_t off_weights = off_joints + align64(nv * K * (narrow ? 1 : 2));
-    size_t off_offsets = off_weights + align64(nv * K * 2);
-    size_t off_tv = off_offsets + align64((rig->tissue_count + 1) * sizeof(size_t));
-    size_t off_bary = off_tv + align64(total * 4 * sizeof(uint32_t));
-    size_t off_key = off_bary + align64(total * 3 * sizeof(float));
-    size_t off_normals = off_key + align64(total * 3 * sizeof(int16_t));
-    size_t off_rest = off_normals + align64(total * 3 * sizeof(float));
-    size_t size = off_rest + align64(nj * sizeof(pose__xform));
+    /* One block of memory: header, skin blocks, tissue blocks, rest frames. */
+    size_t off = align64(sizeof(struct pose__rig_runtime));
+    const size_t off_rest = off;
+    off += align64(nb * 3 * B * sizeof(float));
+    const size_t off_cor = off;
+    off += rig->cor ? align64(nb * 3 * B * sizeof(float)) : 0;
+    const size_t off_active = off;
+    off += align64(nb);
+    const size_t off_joints = off;
+    off += align64(nb * K * B * (narrow ? 1 : 2));
+    const size_t off_weights = off;
+    off += align64(nb * K * B * 2);
+    const size_t off_offsets = off;
+    off += align64((rig->tissue_count + 1) * sizeof(size_t));
+    const size_t off_tv = off;
+    off += align64(tb * 4 * B * sizeof(uint32_t));
+    const size_t off_bary = off;
+    off += align64(tb * 3 * B * sizeof(float));
+    const size_t off_key = off;
+    off += align64(tb * 3 * B * sizeof(int16_t));
+    const size_t off_normals = off;
+    off += align64(total * 3 * sizeof(float));
+    const size_t off_frames = off;
+    off += align64(nj * sizeof(pose__xform));
+    const size_t size = off;
     unsigned char *block = pose__calloc(&rig->allocator, size, POSE__ALIGN);
     if (!block)
         return pose__fail(POSE_ERR_OUT_OF_MEMORY,
                           "out of memory preparing the rig for the runtime (%zu bytes)", size);
-    struct pose__rig_runtime *rt = (struct pose__rig_runtime *)(block + off_rt);
+    struct pose__rig_runtime *rt = (struct pose__rig_runtime *)block;
     rt->block = block;
 
-    uint16_t *w16 = (uint16_t *)(block + off_weights);
+    /* ---- tet vertices: blocks of 8 lanes; padding lanes repeat vertex 0
+     * bound to joint 0 (valid input, never stored) */
+    float *rest = (float *)(block + off_rest);
+    float *cor = rig->cor ? (float *)(block + off_cor) : NULL;
+    uint8_t *active = block + off_active;
     uint8_t *j8 = narrow ? block + off_joints : NULL;
     uint16_t *j16 = narrow ? NULL : (uint16_t *)(block + off_joints);
-    for (size_t i = 0; i < nv; i++) {
-        uint16_t joints[POSE__MAX_INFLUENCES];
-        uint16_t *dst = narrow ? joints : j16 + i * K;
-        compact_weights((unsigned)K, rig->weight_joints + i * K, rig->weights + i * K, dst,
-                        w16 + i * K);
-        if (narrow)
-            for (size_t k = 0; k < K; k++)
-                j8[i * K + k] = (uint8_t)joints[k];
+    uint16_t *w16 = (uint16_t *)(block + off_weights);
+    for (size_t b = 0; b < nb; b++) {
+        unsigned used = 1;
+        for (size_t l = 0; l < B; l++) {
+            size_t i = b * B + l, src = i < nv ? i : 0;
+            for (int c = 0; c < 3; c++) {
+                rest[(b * 3 + (size_t)c) * B + l] = rig->tet_positions[3 * src + (size_t)c];
+                if (cor)
+                    cor[(b * 3 + (size_t)c) * B + l] = rig->cor[3 * src + (size_t)c];
+            }
+            uint16_t joints[POSE__MAX_INFLUENCES], weights[POSE__MAX_INFLUENCES];
+            compact_weights((unsigned)K, rig->weight_joints + src * K, rig->weights + src * K,
+                            joints, weights);
+            for (size_t k = 0; k < K; k++) {
+                size_t at = (b * K + k) * B + l;
+                if (narrow)
+                    j8[at] = (uint8_t)joints[k];
+                else
+                    j16[at] = joints[k];
+                w16[at] = weights[k];
+                if (weights[k] != 0 && k + 1 > used)
+                    used = (unsigned)k + 1;
+            }
+        }
+        active[b] = (uint8_t)used;
     }
     rt->skin = (pose__skin_mesh){
-        .vertex_count = nv, .influences = (unsigned)K, .rest = rig->tet_positions,
-        .cor = rig->cor, .joints8 = j8, .joints16 = j16, .weights = w16,
+        .vertex_count = nv, .block_count = nb, .influences = (unsigned)K, .rest = rest,
+        .cor = cor, .active = active, .joints8 = j8, .joints16 = j16, .weights = w16,
     };
 
+    /* ---- tissue vertices, all tissues one after another, same blocking */
     rt->tissue_offset = (size_t *)(block + off_offsets);
     rt->rest_normals = (float *)(block + off_normals);
     uint32_t *tv = (uint32_t *)(block + off_tv);
@@ -162,18 +200,28 @@ pose_status pose__rig_prepare(pose_rig *rig)
         rt->tissue_offset[t] = base;
         rest_normals(ts, rt->rest_normals + 3 * base);
         for (size_t v = 0; v < ts->vertex_count; v++) {
-            size_t g = base + v;
+            size_t g = base + v, b = g / B, l = g % B;
+            uint32_t corners[4];
+            float b3[3];
+            int16_t k3[3];
             embed_vertex(rig, rig->tets + 4 * (size_t)ts->tet[v], ts->bary + 4 * v,
-                         rt->rest_normals + 3 * g, tv + 4 * g, bary + 3 * g, key + 3 * g);
+                         rt->rest_normals + 3 * g, corners, b3, k3);
+            for (size_t c = 0; c < 4; c++)
+                tv[(b * 4 + c) * B + l] = corners[c];
+            for (size_t c = 0; c < 3; c++) {
+                bary[(b * 3 + c) * B + l] = b3[c];
+                key[(b * 3 + c) * B + l] = k3[c];
+            }
         }
         base += ts->vertex_count;
     }
     rt->tissue_offset[rig->tissue_count] = base;
     rt->transfer = (pose__transfer_mesh){
-        .vertex_count = total, .tet_vertices = tv, .bary = bary, .normal_key = key,
+        .vertex_count = total, .block_count = tb, .tet_vertices = tv, .bary = bary,
+        .normal_key = key,
     };
 
-    rt->rest_model = (pose__xform *)(block + off_rest);
+    rt->rest_model = (pose__xform *)(block + off_frames);
     for (size_t j = 0; j < nj; j++) {
         memcpy(rt->rest_model[j].q, rig->joint_rest_model[j].rotation, sizeof(float) * 4);
         memcpy(rt->rest_model[j].t, rig->joint_rest_model[j].translation, sizeof(float) * 3);

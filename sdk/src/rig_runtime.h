@@ -11,9 +11,9 @@
 #include "rt_transfer.h"
 
 struct pose__rig_runtime {
-    /** Tet vertices: the rig's rest positions and centres, compact weights
-     *  (8-bit joints when the rig has <= 256 joints, 15-bit fixed-point
-     *  weights, largest first, summing exactly to one). */
+    /** Tet vertices in blocks of 8 lanes: rest positions and centres,
+     *  compact weights (8-bit joints when the rig has <= 256 joints, 15-bit
+     *  fixed-point weights, largest first, summing exactly to one). */
     pose__skin_mesh skin;
     /** All tissues' vertices, one after another (tissue t starts at
      *  tissue_offset[t]), in the rig's order: outputs are written in the

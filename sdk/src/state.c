@@ -189,15 +189,15 @@ pose_status pose_set_threads(pose_state *st, int threads)
     return start_pool(st, n);
 }
 
-/* The two parallel passes of pose_apply. Ranges are split by part only:
- * every vertex is computed on its own, so results do not depend on the
- * thread count. */
+/* The two parallel passes of pose_apply, split into whole blocks of 8
+ * vertices by part: every vertex is computed on its own, so results do not
+ * depend on the thread count. */
 static void skin_task(void *ctx, unsigned part, unsigned parts)
 {
     pose_state *st = ctx;
     const pose__skin_mesh *mesh = &st->rt->skin;
-    size_t b = pose__part_begin(mesh->vertex_count, part, parts);
-    size_t e = pose__part_begin(mesh->vertex_count, part + 1, parts);
+    size_t b = pose__part_begin(mesh->block_count, part, parts);
+    size_t e = pose__part_begin(mesh->block_count, part + 1, parts);
     pose__skin((int)st->method, mesh, st->palette, b, e, st->tet_positions);
 }
 
@@ -205,8 +205,8 @@ static void transfer_task(void *ctx, unsigned part, unsigned parts)
 {
     pose_state *st = ctx;
     const pose__transfer_mesh *mesh = &st->rt->transfer;
-    size_t b = pose__part_begin(mesh->vertex_count, part, parts);
-    size_t e = pose__part_begin(mesh->vertex_count, part + 1, parts);
+    size_t b = pose__part_begin(mesh->block_count, part, parts);
+    size_t e = pose__part_begin(mesh->block_count, part + 1, parts);
     pose__transfer(mesh, st->tet_positions, b, e, st->tissue_positions, st->tissue_normals);
 }
 

@@ -1,0 +1,216 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The skinning and transfer kernels, written once over eight-lane vectors
+ * and compiled once per variant: the including file defines POSE__KV(name)
+ * to give the functions their variant suffix. */
+#ifndef POSE__KV
+#  error "define POSE__KV before including rt_kernels_body.h"
+#endif
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "rt_kernels.h"
+#include "rt_simd.h"
+#include "rt_vec.h"
+
+#define WSCALE (1.0f / 32768.0f)
+#define PAL_STRIDE 16 /* floats per pose__skin_joint */
+
+/* Palette offsets (in floats) of joint k's entries, for the lanes of block b. */
+static POSE__INLINE void joint_offsets(const pose__skin_mesh *m, size_t b, size_t k,
+                                       int32_t idx[8])
+{
+    size_t row = (b * m->influences + k) * POSE__BLOCK;
+    if (m->joints8)
+        for (int l = 0; l < 8; l++)
+            idx[l] = (int32_t)m->joints8[row + (size_t)l] * PAL_STRIDE;
+    else
+        for (int l = 0; l < 8; l++)
+            idx[l] = (int32_t)m->joints16[row + (size_t)l] * PAL_STRIDE;
+}
+
+/* Weights of influence k for the lanes of block b (a macro: vectors are not
+ * passed by value, whose ABI differs between the variants). */
+#define block_weights(m, b, k)                                                       \
+    (__builtin_convertvector(                                                        \
+         *(const pose__v8u16 *)((m)->weights + ((b) * (m)->influences + (k)) * POSE__BLOCK), \
+         pose__v8f) * WSCALE)
+
+static POSE__INLINE void store_lanes(float *restrict out, size_t b, size_t count,
+                                     const pose__v8f *px, const pose__v8f *py,
+                                     const pose__v8f *pz)
+{
+    const pose__v8f x = *px, y = *py, z = *pz;
+    size_t n = count - b * POSE__BLOCK;
+    float *o = out + 3 * POSE__BLOCK * b;
+    if (n >= 8) {
+        for (int l = 0; l < 8; l++) {
+            o[3 * l + 0] = x[l];
+            o[3 * l + 1] = y[l];
+            o[3 * l + 2] = z[l];
+        }
+        return;
+    }
+    for (size_t l = 0; l < n; l++) {
+        o[3 * l + 0] = x[l];
+        o[3 * l + 1] = y[l];
+        o[3 * l + 2] = z[l];
+    }
+}
+
+void POSE__KV(pose__skin_blocks)(int method, const pose__skin_mesh *m,
+                                 const pose__skin_joint *palette, size_t begin, size_t end,
+                                 float *restrict out)
+{
+    const float *pf = (const float *)palette;
+    for (size_t b = begin; b < end; b++) {
+        const float *rb = m->rest + 3 * POSE__BLOCK * b;
+        const pose__v8f vx = *(const pose__v8f *)rb;
+        const pose__v8f vy = *(const pose__v8f *)(rb + 8);
+        const pose__v8f vz = *(const pose__v8f *)(rb + 16);
+        const unsigned kb = m->active[b];
+        int32_t idx[8];
+        joint_offsets(m, b, 0, idx);
+        pose__v8f q0x = V8_GATHER(pf, idx, 0), q0y = V8_GATHER(pf, idx, 1);
+        pose__v8f q0z = V8_GATHER(pf, idx, 2), q0w = V8_GATHER(pf, idx, 3);
+        pose__v8f ox, oy, oz, rx, ry, rz;
+        if (kb == 1) {
+            /* every lane bound to one joint: rigid, the same for all methods */
+            pose__v8f tx = V8_GATHER(pf, idx, 4), ty = V8_GATHER(pf, idx, 5);
+            pose__v8f tz = V8_GATHER(pf, idx, 6);
+            V8_ROTDISP(rx, ry, rz, q0x, q0y, q0z, q0w, vx, vy, vz);
+            ox = vx + (rx + tx);
+            oy = vy + (ry + ty);
+            oz = vz + (rz + tz);
+        } else if (method == POSE__SKIN_LBS) {
+            /* v' = v + sum w (R v - v + t) */
+            pose__v8f dx = V8_SPLAT(0.0f), dy = dx, dz = dx;
+            for (unsigned k = 0; k < kb; k++) {
+                if (k > 0)
+                    joint_offsets(m, b, k, idx);
+                pose__v8f w = block_weights(m, b, k);
+                pose__v8f qx = V8_GATHER(pf, idx, 0), qy = V8_GATHER(pf, idx, 1);
+                pose__v8f qz = V8_GATHER(pf, idx, 2), qw = V8_GATHER(pf, idx, 3);
+                pose__v8f tx = V8_GATHER(pf, idx, 4), ty = V8_GATHER(pf, idx, 5);
+                pose__v8f tz = V8_GATHER(pf, idx, 6);
+                V8_ROTDISP(rx, ry, rz, qx, qy, qz, qw, vx, vy, vz);
+                dx += w * (rx + tx);
+                dy += w * (ry + ty);
+                dz += w * (rz + tz);
+            }
+            ox = vx + dx;
+            oy = vy + dy;
+            oz = vz + dz;
+        } else if (method == POSE__SKIN_DQS) {
+            /* blend dual quaternions, signs aligned to the first joint's */
+            pose__v8f bx = V8_SPLAT(0.0f), by = bx, bz = bx, bw = bx;
+            pose__v8f ex = bx, ey = bx, ez = bx, ew = bx;
+            for (unsigned k = 0; k < kb; k++) {
+                if (k > 0)
+                    joint_offsets(m, b, k, idx);
+                pose__v8f qx = V8_GATHER(pf, idx, 0), qy = V8_GATHER(pf, idx, 1);
+                pose__v8f qz = V8_GATHER(pf, idx, 2), qw = V8_GATHER(pf, idx, 3);
+                pose__v8f dot = qx * q0x + qy * q0y + qz * q0z + qw * q0w;
+                pose__v8f w = V8_NEG_WHERE(block_weights(m, b, k), dot);
+                bx += w * qx; by += w * qy; bz += w * qz; bw += w * qw;
+                ex += w * V8_GATHER(pf, idx, 8);
+                ey += w * V8_GATHER(pf, idx, 9);
+                ez += w * V8_GATHER(pf, idx, 10);
+                ew += w * V8_GATHER(pf, idx, 11);
+            }
+            pose__v8f inv = 1.0f / V8_SQRT(bx * bx + by * by + bz * bz + bw * bw);
+            bx *= inv; by *= inv; bz *= inv; bw *= inv;
+            ex *= inv; ey *= inv; ez *= inv; ew *= inv;
+            /* t = 2 (e b*).xyz = 2 (bw e - ew b + b x e) */
+            pose__v8f tx = 2.0f * ((bw * ex - ew * bx) + (by * ez - bz * ey));
+            pose__v8f ty = 2.0f * ((bw * ey - ew * by) + (bz * ex - bx * ez));
+            pose__v8f tz = 2.0f * ((bw * ez - ew * bz) + (bx * ey - by * ex));
+            V8_ROTDISP(rx, ry, rz, bx, by, bz, bw, vx, vy, vz);
+            ox = vx + (rx + tx);
+            oy = vy + (ry + ty);
+            oz = vz + (rz + tz);
+        } else {
+            /* CoR: q = normalize(sum w q_j) aligned, t = (sum w M_j) c - R c:
+             * v' = v + (R - I)(v - c) + sum w ((R_j - I) c + t_j) */
+            const float *cb = m->cor + 3 * POSE__BLOCK * b;
+            const pose__v8f cx = *(const pose__v8f *)cb;
+            const pose__v8f cy = *(const pose__v8f *)(cb + 8);
+            const pose__v8f cz = *(const pose__v8f *)(cb + 16);
+            pose__v8f bx = V8_SPLAT(0.0f), by = bx, bz = bx, bw = bx;
+            pose__v8f dx = bx, dy = bx, dz = bx;
+            for (unsigned k = 0; k < kb; k++) {
+                if (k > 0)
+                    joint_offsets(m, b, k, idx);
+                pose__v8f w = block_weights(m, b, k);
+                pose__v8f qx = V8_GATHER(pf, idx, 0), qy = V8_GATHER(pf, idx, 1);
+                pose__v8f qz = V8_GATHER(pf, idx, 2), qw = V8_GATHER(pf, idx, 3);
+                pose__v8f dot = qx * q0x + qy * q0y + qz * q0z + qw * q0w;
+                pose__v8f ws = V8_NEG_WHERE(w, dot);
+                bx += ws * qx; by += ws * qy; bz += ws * qz; bw += ws * qw;
+                V8_ROTDISP(rx, ry, rz, qx, qy, qz, qw, cx, cy, cz);
+                dx += w * (rx + V8_GATHER(pf, idx, 4));
+                dy += w * (ry + V8_GATHER(pf, idx, 5));
+                dz += w * (rz + V8_GATHER(pf, idx, 6));
+            }
+            pose__v8f inv = 1.0f / V8_SQRT(bx * bx + by * by + bz * bz + bw * bw);
+            bx *= inv; by *= inv; bz *= inv; bw *= inv;
+            pose__v8f px = vx - cx, py = vy - cy, pz = vz - cz;
+            V8_ROTDISP(rx, ry, rz, bx, by, bz, bw, px, py, pz);
+            ox = vx + (rx + dx);
+            oy = vy + (ry + dy);
+            oz = vz + (rz + dz);
+        }
+        store_lanes(out, b, m->vertex_count, &ox, &oy, &oz);
+    }
+}
+
+void POSE__KV(pose__transfer_blocks)(const pose__transfer_mesh *m, const float *restrict tp,
+                                     size_t begin, size_t end, float *restrict pos,
+                                     float *restrict nrm)
+{
+    for (size_t b = begin; b < end; b++) {
+        const uint32_t *tv = m->tet_vertices + 4 * POSE__BLOCK * b;
+        int32_t i0[8], i1[8], i2[8], i3[8];
+        for (int l = 0; l < 8; l++) {
+            i0[l] = (int32_t)(3 * tv[l]);
+            i1[l] = (int32_t)(3 * tv[8 + l]);
+            i2[l] = (int32_t)(3 * tv[16 + l]);
+            i3[l] = (int32_t)(3 * tv[24 + l]);
+        }
+        const pose__v8f v0x = V8_GATHER(tp, i0, 0), v0y = V8_GATHER(tp, i0, 1),
+                        v0z = V8_GATHER(tp, i0, 2);
+        const pose__v8f e1x = V8_GATHER(tp, i1, 0) - v0x, e1y = V8_GATHER(tp, i1, 1) - v0y,
+                        e1z = V8_GATHER(tp, i1, 2) - v0z;
+        const pose__v8f e2x = V8_GATHER(tp, i2, 0) - v0x, e2y = V8_GATHER(tp, i2, 1) - v0y,
+                        e2z = V8_GATHER(tp, i2, 2) - v0z;
+        const pose__v8f e3x = V8_GATHER(tp, i3, 0) - v0x, e3y = V8_GATHER(tp, i3, 1) - v0y,
+                        e3z = V8_GATHER(tp, i3, 2) - v0z;
+        const float *bb = m->bary + 3 * POSE__BLOCK * b;
+        const pose__v8f b1 = *(const pose__v8f *)bb, b2 = *(const pose__v8f *)(bb + 8),
+                        b3 = *(const pose__v8f *)(bb + 16);
+        const pose__v8f px = v0x + (b1 * e1x + b2 * e2x + b3 * e3x);
+        const pose__v8f py = v0y + (b1 * e1y + b2 * e2y + b3 * e3y);
+        const pose__v8f pz = v0z + (b1 * e1z + b2 * e2z + b3 * e3z);
+        store_lanes(pos, b, m->vertex_count, &px, &py, &pz);
+        if (!nrm)
+            continue;
+        const int16_t *kb = m->normal_key + 3 * POSE__BLOCK * b;
+        const pose__v8f k1 = __builtin_convertvector(*(const pose__v8i16 *)kb, pose__v8f);
+        const pose__v8f k2 = __builtin_convertvector(*(const pose__v8i16 *)(kb + 8), pose__v8f);
+        const pose__v8f k3 = __builtin_convertvector(*(const pose__v8i16 *)(kb + 16), pose__v8f);
+        /* cof(D') k = k1 (e2 x e3) + k2 (e3 x e1) + k3 (e1 x e2) */
+        pose__v8f nx = k1 * (e2y * e3z - e2z * e3y) + k2 * (e3y * e1z - e3z * e1y) +
+                       k3 * (e1y * e2z - e1z * e2y);
+        pose__v8f ny = k1 * (e2z * e3x - e2x * e3z) + k2 * (e3z * e1x - e3x * e1z) +
+                       k3 * (e1z * e2x - e1x * e2z);
+        pose__v8f nz = k1 * (e2x * e3y - e2y * e3x) + k2 * (e3x * e1y - e3y * e1x) +
+                       k3 * (e1x * e2y - e1y * e2x);
+        pose__v8f n2 = nx * nx + ny * ny + nz * nz;
+        /* a flattened tet or a vertex without triangles has no normal: 0 */
+        pose__v8f s = V8_AND_MASK(1.0f / V8_SQRT(n2), n2 > 1e-36f);
+        nx *= s;
+        ny *= s;
+        nz *= s;
+        store_lanes(nrm, b, m->vertex_count, &nx, &ny, &nz);
+    }
+}

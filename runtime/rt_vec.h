@@ -1,0 +1,58 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* Eight-lane float vectors (GCC/clang vector extensions) for the kernels.
+ * The same source is compiled for the baseline target and, on x86-64, with
+ * -mavx2; each variant performs the same IEEE operations in the same order
+ * (no fused multiply-add), so results are bit-identical across variants. */
+#ifndef POSE_RT_VEC_H
+#define POSE_RT_VEC_H
+
+#include <math.h>
+#include <stdint.h>
+
+#ifdef __AVX__
+#  include <immintrin.h>
+#endif
+
+typedef float pose__v8f __attribute__((vector_size(32)));
+typedef int32_t pose__v8i __attribute__((vector_size(32)));
+typedef uint16_t pose__v8u16 __attribute__((vector_size(16)));
+typedef int16_t pose__v8i16 __attribute__((vector_size(16)));
+typedef uint8_t pose__v8u8 __attribute__((vector_size(8)));
+
+#define V8_SPLAT(x) ((pose__v8f){(x), (x), (x), (x), (x), (x), (x), (x)})
+/* Lane l takes base[idx[l] + off]. */
+#define V8_GATHER(base, idx, off)                                                   \
+    ((pose__v8f){(base)[(idx)[0] + (off)], (base)[(idx)[1] + (off)],                \
+                 (base)[(idx)[2] + (off)], (base)[(idx)[3] + (off)],                \
+                 (base)[(idx)[4] + (off)], (base)[(idx)[5] + (off)],                \
+                 (base)[(idx)[6] + (off)], (base)[(idx)[7] + (off)]})
+/* Flip the sign of w in the lanes where neg < 0 (exactly -w). */
+#define V8_NEG_WHERE(w, neg)                                                        \
+    ((pose__v8f)((pose__v8i)(w) ^ ((pose__v8i)((neg) < 0.0f) &                      \
+                                   (pose__v8i)V8_SPLAT(-0.0f))))
+/* Keep x where cond holds, else +0. */
+#define V8_AND_MASK(x, cond) ((pose__v8f)((pose__v8i)(x) & (pose__v8i)(cond)))
+
+#ifdef __AVX__
+#  define V8_SQRT(x) ((pose__v8f)_mm256_sqrt_ps((__m256)(x)))
+#else
+#  define V8_SQRT(x)                                                                \
+      ((pose__v8f){sqrtf((x)[0]), sqrtf((x)[1]), sqrtf((x)[2]), sqrtf((x)[3]),      \
+                   sqrtf((x)[4]), sqrtf((x)[5]), sqrtf((x)[6]), sqrtf((x)[7])})
+#endif
+
+/* r = R(q) x - x = 2 (w (u x x) + u x (u x x)), u = q.xyz: exactly 0 when u = 0. */
+#define V8_ROTDISP(rx, ry, rz, ux, uy, uz, uw, x, y, z)                             \
+    do {                                                                            \
+        pose__v8f cx_ = (uy) * (z) - (uz) * (y);                                    \
+        pose__v8f cy_ = (uz) * (x) - (ux) * (z);                                    \
+        pose__v8f cz_ = (ux) * (y) - (uy) * (x);                                    \
+        pose__v8f dx_ = (uy) * cz_ - (uz) * cy_;                                    \
+        pose__v8f dy_ = (uz) * cx_ - (ux) * cz_;                                    \
+        pose__v8f dz_ = (ux) * cy_ - (uy) * cx_;                                    \
+        (rx) = 2.0f * ((uw) * cx_ + dx_);                                           \
+        (ry) = 2.0f * ((uw) * cy_ + dy_);                                           \
+        (rz) = 2.0f * ((uw) * cz_ + dz_);                                           \
+    } while (0)
+
+#endif /* POSE_RT_VEC_H */
