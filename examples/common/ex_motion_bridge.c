@@ -1,34 +1,40 @@
 /* SPDX-License-Identifier: Apache-2.0
  *
- * ex_motion over the bridge library: the clip is parsed by the bridge
- * (pb_clip_load), retargeted onto the rig by the bridge (pb_retarget_*) and
- * applied by the bridge (pb_pose_apply_to_state). This file only chooses
- * frames and blends between two of them for in-between times.
+ * ex_motion over the bridge library. Everything that reads, decodes, maps or
+ * times inputs is the bridge's: clips are parsed by pb_clip_load and
+ * retargeted by pb_retarget_*, HID and CAN sources are opened by pb_hid_open,
+ * pb_candump_replay_open and pb_can_live_open, live playback runs on the
+ * bridge's own thread (pb_runner) and poses reach the state through
+ * pb_pose_apply_to_state. This file only picks the right calls.
  */
 #include "ex_motion.h"
 
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 
 #include "bridge_apply.h"
+#include "can_bus.h"
+#include "can_source.h"
+#include "hid_open.h"
 #include "mapping.h"
 #include "mocap.h"
 #include "rig_skel.h"
+#include "runner.h"
 
 struct ex_motion {
-    pb_clip *clip;
+    char name[128];
+    pb_clip *clip;      /* a mocap clip, or NULL for a device source */
+    pb_source *src;     /* a device source until the runner takes it */
     pb_mapping *map;
     pb_rig_skel *skel;
-    pb_retarget *rt;
+    pb_retarget *rt;    /* frame-by-frame retargeting (clips) */
     pb_pose pose;
-    double (*lq)[4], (*lt)[3];   /* clip local transforms of one frame */
-    double (*lq2)[4], (*lt2)[3]; /* of the next frame, for blending */
-    double last_t;
-    int clamped;
-    char status[256];
+    double (*lq)[4], (*lt)[3];
+    pb_runner *runner;
+    int paused;
+    char status[512];
 };
 
 int ex_motion_available(void)
@@ -56,58 +62,110 @@ static int find_asf(const char *amc, char *out, size_t out_size)
     return stat(out, &sb) == 0 ? 0 : -1;
 }
 
+static int open_clip(ex_motion *m, const char *source, pb_error *pe, char *err, size_t err_size)
+{
+    char asf[4096];
+    const char *skeleton = NULL;
+    if (ends_with(source, ".amc")) {
+        if (find_asf(source, asf, sizeof asf) < 0) {
+            snprintf(err, err_size, "%s: no skeleton file beside it (expected %s)", source, asf);
+            return -1;
+        }
+        skeleton = asf;
+    }
+    if (pb_clip_load(source, skeleton, &m->clip, pe) < 0 || pb_retarget_create(m->map, m->clip, m->skel, &m->rt, pe) < 0)
+        return -1;
+    if (m->clip->frame_count == 0) {
+        snprintf(err, err_size, "%s: the clip has no frames", source);
+        return -1;
+    }
+    m->lq = calloc((size_t)m->clip->joint_count, sizeof *m->lq);
+    m->lt = calloc((size_t)m->clip->joint_count, sizeof *m->lt);
+    if (!m->lq || !m->lt) {
+        snprintf(err, err_size, "out of memory");
+        return -1;
+    }
+    return 0;
+}
+
+/* CAN: a candump -l log, or "can:IFACE" / an interface name; the bus comes from the mapping's "can". */
+static int open_can(ex_motion *m, const char *source, const char *map, pb_error *pe)
+{
+    pb_can_bus *bus = NULL;
+    if (pb_can_bus_load(map, &bus, pe) < 0)
+        return -1;
+    if (ends_with(source, ".log")) {
+        pb_candump_replay_options opt = {.loop = 1};
+        return pb_candump_replay_open(source, bus, &opt, &m->src, pe) < 0 ? -1 : 0;
+    }
+    const char *iface = !strncmp(source, "can:", 4) ? source + 4 : source;
+    return pb_can_live_open(iface, bus, NULL, &m->src, pe) < 0 ? -1 : 0;
+}
+
+/* What kind of source a command-line spec names: 'c' clip, 'h' HID, 'n' CAN, 0 unknown. */
+static char source_kind(const char *s)
+{
+    if (ends_with(s, ".bvh") || ends_with(s, ".BVH") || ends_with(s, ".amc"))
+        return 'c';
+    if (ends_with(s, ".hid") || !strncmp(s, "/dev/hidraw", 11) || !strncmp(s, "hid:", 4))
+        return 'h';
+    if (ends_with(s, ".log") || !strncmp(s, "can:", 4) || (!strchr(s, '/') && !strchr(s, '.') && *s))
+        return 'n'; /* a candump -l log, or an interface such as can0 / vcan0 */
+    return 0;
+}
+
 int ex_motion_open(const char *source, const char *map, const pose_rig *rig, ex_motion **out, char *err,
                    size_t err_size)
 {
     pb_error pe = {{0}};
-    char asf[4096];
-    const char *skeleton = NULL;
     *out = NULL;
-    if (!ends_with(source, ".bvh") && !ends_with(source, ".BVH") && !ends_with(source, ".amc")) {
+    char kind = source_kind(source);
+    int clip = kind == 'c';
+    if (!kind) {
         snprintf(err, err_size,
-                 "%s: not a motion clip (.bvh, or .amc with its .asf beside it); recordings of HID and CAN "
-                 "devices are replayed by pose-bridge",
+                 "%s: unknown kind of source (expected .bvh, .amc, .hid, /dev/hidrawN, hid:VID:PID, "
+                 "a candump .log, or a CAN interface such as can0)",
                  source);
         return -1;
     }
-    if (ends_with(source, ".amc")) {
-        if (find_asf(source, asf, sizeof asf) < 0) {
-            snprintf(err, err_size, "%s: no skeleton file (expected %s)", source, asf);
-            return -1;
-        }
-        skeleton = asf;
+    if (!clip && !map) {
+        snprintf(err, err_size, "%s: a HID or CAN source needs --map (a mapping file with \"channels\")", source);
+        return -1;
     }
     ex_motion *m = calloc(1, sizeof *m);
     if (!m) {
         snprintf(err, err_size, "out of memory");
         return -1;
     }
-    if (pb_clip_load(source, skeleton, &m->clip, &pe) < 0 ||
-        (map ? pb_mapping_load(map, &m->map, &pe) : pb_mapping_identity(&m->map, &pe)) < 0 ||
-        pb_rig_skel_from_rig(rig, &m->skel, &pe) < 0 || pb_retarget_create(m->map, m->clip, m->skel, &m->rt, &pe) < 0) {
-        snprintf(err, err_size, "%s", pe.message[0] ? pe.message : "cannot open the source");
-        ex_motion_close(m);
-        return -1;
+    snprintf(m->name, sizeof m->name, "%s", strrchr(source, '/') ? strrchr(source, '/') + 1 : source);
+    int rc = (map ? pb_mapping_load(map, &m->map, &pe) : pb_mapping_identity(&m->map, &pe)) < 0 ||
+                     pb_rig_skel_from_rig(rig, &m->skel, &pe) < 0
+                 ? -1
+                 : 0;
+    if (rc == 0) {
+        if (clip)
+            rc = open_clip(m, source, &pe, err, err_size);
+        else if (kind == 'n')
+            rc = open_can(m, source, map, &pe);
+        else
+            rc = pb_hid_open(source, &(pb_hid_replay_options){.loop = 1}, &m->src, &pe) < 0 ? -1 : 0;
     }
-    if (m->clip->frame_count == 0) {
-        snprintf(err, err_size, "%s: the clip has no frames", source);
-        ex_motion_close(m);
-        return -1;
-    }
-    size_t nj = (size_t)m->clip->joint_count;
-    m->lq = calloc(nj, sizeof *m->lq);
-    m->lt = calloc(nj, sizeof *m->lt);
-    m->lq2 = calloc(nj, sizeof *m->lq2);
-    m->lt2 = calloc(nj, sizeof *m->lt2);
-    if (!m->lq || !m->lt || !m->lq2 || !m->lt2 || pb_pose_init(&m->pose, m->skel->joint_count) != 0) {
+    if (rc == 0 && pb_pose_init(&m->pose, m->skel->joint_count) != 0) {
         snprintf(err, err_size, "out of memory");
+        rc = -1;
+    }
+    if (rc < 0) {
+        if (pe.message[0])
+            snprintf(err, err_size, "%s", pe.message);
         ex_motion_close(m);
         return -1;
     }
-    m->last_t = -1.0;
-    snprintf(m->status, sizeof m->status, "%s %s, %zu frames at %.0f Hz, %d joints mapped", m->clip->format,
-             strrchr(source, '/') ? strrchr(source, '/') + 1 : source, m->clip->frame_count,
-             1.0 / m->clip->frame_time, pb_retarget_mapped_count(m->rt));
+    if (m->clip)
+        snprintf(m->status, sizeof m->status, "%s: %zu frames at %.0f Hz, %d joints mapped", m->name,
+                 m->clip->frame_count, 1.0 / m->clip->frame_time, pb_retarget_mapped_count(m->rt));
+    else
+        snprintf(m->status, sizeof m->status, "%s: %s, %zu channels", m->name, m->src->ops->kind,
+                 m->src->channel_count);
     *out = m;
     return 0;
 }
@@ -116,6 +174,9 @@ void ex_motion_close(ex_motion *m)
 {
     if (!m)
         return;
+    pb_runner_stop(m->runner, NULL); /* destroys a source it was given */
+    if (!m->runner)
+        pb_source_destroy(m->src);
     pb_pose_free(&m->pose);
     pb_retarget_free(m->rt);
     pb_rig_skel_free(m->skel);
@@ -123,80 +184,116 @@ void ex_motion_close(ex_motion *m)
     pb_clip_free(m->clip);
     free(m->lq);
     free(m->lt);
-    free(m->lq2);
-    free(m->lt2);
     free(m);
 }
 
 long ex_motion_frame_count(const ex_motion *m)
 {
-    return (long)m->clip->frame_count;
+    return m->clip ? (long)m->clip->frame_count : -1;
 }
 
 double ex_motion_frame_time(const ex_motion *m)
 {
-    return m->clip->frame_time;
-}
-
-/* Retarget the clip transforms in m->lq/lt and set them on the state. */
-static int apply(ex_motion *m, pose_state *st, double dt, char *err, size_t err_size)
-{
-    pb_retarget_apply(m->rt, (const double(*)[4])m->lq, (const double(*)[3])m->lt, dt, &m->pose);
-    if (pb_pose_apply_to_state(&m->pose, st, &m->clamped) < 0) {
-        snprintf(err, err_size, "cannot apply the pose: %s", pose_last_error());
-        return -1;
-    }
-    return 0;
+    return m->clip ? m->clip->frame_time : 0.0;
 }
 
 int ex_motion_set_frame(ex_motion *m, pose_state *st, long frame, char *err, size_t err_size)
 {
+    if (!m->clip) {
+        snprintf(err, err_size, "%s: a device source or recording has no frames to pick; play it live "
+                                "(pose-view, pose-bridge)", m->name);
+        return -1;
+    }
     if (frame < 0 || (size_t)frame >= m->clip->frame_count) {
         snprintf(err, err_size, "%s: frame %ld is out of range (0..%zu)", m->clip->path, frame,
                  m->clip->frame_count - 1);
         return -1;
     }
     pb_clip_local(m->clip, pb_clip_frame(m->clip, (size_t)frame), m->lq, m->lt);
-    m->last_t = -1.0; /* a jump: filters start afresh */
-    return apply(m, st, 0.0, err, err_size);
+    pb_retarget_apply(m->rt, (const double(*)[4])m->lq, (const double(*)[3])m->lt, 0.0, &m->pose);
+    if (pb_pose_apply_to_state(&m->pose, st, NULL) < 0) {
+        snprintf(err, err_size, "cannot apply frame %ld: %s", frame, pose_last_error());
+        return -1;
+    }
+    return 0;
 }
 
-int ex_motion_set_time(ex_motion *m, pose_state *st, double t, char *err, size_t err_size)
+int ex_motion_start(ex_motion *m, char *err, size_t err_size)
 {
-    double ft = m->clip->frame_time, pos = t / ft;
-    size_t n = m->clip->frame_count;
-    if (!(pos >= 0.0))
-        pos = 0.0;
-    size_t f = (size_t)pos;
-    if (f >= n - 1) {
-        f = n - 1;
-        pos = (double)f;
+    pb_error pe = {{0}};
+    pb_runner_options opt = {.speed = 1.0, .loop = 1};
+    pose_status st = m->clip ? pb_runner_start_clip(m->clip, m->skel, m->map, &opt, &m->runner, &pe)
+                             : pb_runner_start_source(m->src, m->skel, m->map, &opt, &m->runner, &pe);
+    if (st < 0) {
+        if (st == POSE_ERR_THREAD)
+            m->src = NULL; /* the runner had taken it and destroyed it */
+        snprintf(err, err_size, "%s", pe.message[0] ? pe.message : "cannot start the bridge thread");
+        return -1;
     }
-    double a = pos - (double)f;
-    pb_clip_local(m->clip, pb_clip_frame(m->clip, f), m->lq, m->lt);
-    if (a > 0.0) {
-        /* Between two recorded frames: normalized lerp of rotations (sign-aligned), lerp of offsets. */
-        pb_clip_local(m->clip, pb_clip_frame(m->clip, f + 1), m->lq2, m->lt2);
-        for (int j = 0; j < m->clip->joint_count; j++) {
-            double *q = m->lq[j], *q2 = m->lq2[j], d = q[0] * q2[0] + q[1] * q2[1] + q[2] * q2[2] + q[3] * q2[3];
-            double s = d < 0.0 ? -a : a, len = 0.0;
-            for (int k = 0; k < 4; k++) {
-                q[k] = (1.0 - a) * q[k] + s * q2[k];
-                len += q[k] * q[k];
-            }
-            len = sqrt(len);
-            for (int k = 0; k < 4 && len > 0.0; k++)
-                q[k] /= len;
-            for (int k = 0; k < 3; k++)
-                m->lt[j][k] = (1.0 - a) * m->lt[j][k] + a * m->lt2[j][k];
-        }
-    }
-    double dt = m->last_t >= 0.0 && t >= m->last_t ? t - m->last_t : 0.0;
-    m->last_t = t;
-    return apply(m, st, dt, err, err_size);
+    m->src = NULL;
+    return 0;
 }
 
-const char *ex_motion_status(const ex_motion *m)
+int ex_motion_poll(ex_motion *m, pose_state *st, char *err, size_t err_size)
 {
+    int fresh = 0;
+    const pb_pose *p = m->runner ? pb_runner_latest(m->runner, &fresh) : NULL;
+    if (!p || !fresh || p->seq == 0)
+        return 0;
+    if (pb_pose_apply_to_state(p, st, NULL) < 0) {
+        snprintf(err, err_size, "cannot apply the pose: %s", pose_last_error());
+        return -1;
+    }
+    return 1;
+}
+
+void ex_motion_pause(ex_motion *m, int paused)
+{
+    if (m->runner)
+        pb_runner_pause(m->runner, paused);
+    m->paused = paused;
+}
+
+int ex_motion_paused(const ex_motion *m)
+{
+    return m->paused;
+}
+
+void ex_motion_seek(ex_motion *m, double media_s)
+{
+    if (m->runner && m->clip)
+        pb_runner_seek(m->runner, media_s < 0.0 ? 0.0 : media_s);
+}
+
+void ex_motion_step(ex_motion *m, int ticks)
+{
+    if (m->runner && m->clip) {
+        ex_motion_pause(m, 1);
+        pb_runner_step(m->runner, ticks);
+    }
+}
+
+double ex_motion_time(const ex_motion *m)
+{
+    pb_runner_stats s;
+    if (!m->runner)
+        return 0.0;
+    pb_runner_stats_get(m->runner, &s);
+    return s.media_s;
+}
+
+const char *ex_motion_status(ex_motion *m)
+{
+    if (!m->runner)
+        return m->status;
+    pb_runner_stats s;
+    pb_runner_stats_get(m->runner, &s);
+    if (m->clip)
+        snprintf(m->status, sizeof m->status, "%s  frame %ld/%zu  %.0f poses/s  lag %.2f ms  %s%s", m->name,
+                 s.frame, m->clip->frame_count, s.fps, s.lag_ms, pb_source_state_name(s.state),
+                 m->paused ? " (paused)" : "");
+    else
+        snprintf(m->status, sizeof m->status, "%s  %llu poses, %.0f/s  %s", m->name, (unsigned long long)s.ticks,
+                 s.fps, pb_source_state_name(s.state));
     return m->status;
 }

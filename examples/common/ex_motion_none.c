@@ -21,6 +21,7 @@ int ex_motion_open(const char *source, const char *map, const pose_rig *rig, ex_
     return -1;
 }
 
+/* Nothing below is reachable without a successful open; they keep the interface whole. */
 void ex_motion_close(ex_motion *m)
 {
     (void)m;
@@ -29,7 +30,7 @@ void ex_motion_close(ex_motion *m)
 long ex_motion_frame_count(const ex_motion *m)
 {
     (void)m;
-    return 0;
+    return -1;
 }
 
 double ex_motion_frame_time(const ex_motion *m)
@@ -47,13 +48,47 @@ int ex_motion_set_frame(ex_motion *m, pose_state *st, long frame, char *err, siz
     return -1;
 }
 
-int ex_motion_set_time(ex_motion *m, pose_state *st, double t, char *err, size_t err_size)
+int ex_motion_start(ex_motion *m, char *err, size_t err_size)
 {
-    (void)t;
+    return ex_motion_set_frame(m, NULL, 0, err, err_size);
+}
+
+int ex_motion_poll(ex_motion *m, pose_state *st, char *err, size_t err_size)
+{
     return ex_motion_set_frame(m, st, 0, err, err_size);
 }
 
-const char *ex_motion_status(const ex_motion *m)
+void ex_motion_pause(ex_motion *m, int paused)
+{
+    (void)m;
+    (void)paused;
+}
+
+int ex_motion_paused(const ex_motion *m)
+{
+    (void)m;
+    return 1;
+}
+
+void ex_motion_seek(ex_motion *m, double media_s)
+{
+    (void)m;
+    (void)media_s;
+}
+
+void ex_motion_step(ex_motion *m, int ticks)
+{
+    (void)m;
+    (void)ticks;
+}
+
+double ex_motion_time(const ex_motion *m)
+{
+    (void)m;
+    return 0.0;
+}
+
+const char *ex_motion_status(ex_motion *m)
 {
     (void)m;
     return "no bridge";

@@ -23,9 +23,6 @@ typedef struct viewer {
     ex_motion *motion;
     int joint;           /* selected joint */
     float (*euler)[3];   /* per joint, the hand-set angles in degrees */
-    int playing;
-    double play_t;       /* seconds into the source */
-    double speed;
     int show_joints, show_help;
     double fps, last_mouse[2];
     int dragging;        /* 0, 1 orbit, 2 pan */
@@ -36,9 +33,10 @@ static void usage(FILE *f)
 {
     fputs("usage: pose-view RIG [options]\n"
           "Interactive viewer (needs a display).\n"
-          "  --source FILE           drive the pose from a source through the bridge\n"
-          "                          (BVH, ASF/AMC, HID or CAN recording, device)\n"
-          "  --map FILE              the bridge mapping file for --source\n"
+          "  --source SPEC           drive the pose through the bridge, in real time: a clip\n"
+          "                          (.bvh, .amc), a hid-recorder file (.hid), /dev/hidrawN or\n"
+          "                          hid:VID:PID, a candump log (.log) or a CAN interface (can0)\n"
+          "  --map FILE              the bridge mapping file for --source (bridge/maps/)\n"
           "  --method lbs|dqs|cor    initial skinning method (default: cor when the rig has CoR data)\n"
           "  --pose JOINT=RX,RY,RZ   initial joint angles (degrees; repeatable)\n"
           "  --size WxH              window size (default 1280x800)\n"
@@ -92,16 +90,6 @@ static void rotate_selected(viewer *v, int axis, float step)
     }
 }
 
-static void seek(viewer *v, double t)
-{
-    if (!v->motion)
-        return;
-    long n = ex_motion_frame_count(v->motion);
-    double dt = ex_motion_frame_time(v->motion);
-    double end = n > 0 && dt > 0.0 ? (double)(n - 1) * dt : 0.0;
-    v->play_t = t < 0.0 ? 0.0 : (n > 0 && t > end) ? end : t;
-}
-
 static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
 {
     (void)scancode;
@@ -111,7 +99,7 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     char err[512];
     float step = (mods & GLFW_MOD_SHIFT) ? -5.0f : 5.0f;
     size_t nj = pose_rig_joint_count(v->sc.rig);
-    double dt = v->motion ? ex_motion_frame_time(v->motion) : 0.0;
+    double dt = v->motion ? ex_motion_frame_time(v->motion) : 0.0, now = v->motion ? ex_motion_time(v->motion) : 0.0;
     switch (key) {
     case GLFW_KEY_ESCAPE:
     case GLFW_KEY_Q: glfwSetWindowShouldClose(w, 1); break;
@@ -162,12 +150,30 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
         ex_camera_frame(&v->cam, bmin, bmax, fh > 0 ? (float)fw / (float)fh : 1.0f);
         break;
     }
-    case GLFW_KEY_SPACE: v->playing = !v->playing; break;
-    case GLFW_KEY_PERIOD: v->playing = 0; seek(v, v->play_t + (dt > 0.0 ? dt : 1.0 / 30.0)); break;
-    case GLFW_KEY_COMMA: v->playing = 0; seek(v, v->play_t - (dt > 0.0 ? dt : 1.0 / 30.0)); break;
-    case GLFW_KEY_HOME: seek(v, 0.0); break;
-    case GLFW_KEY_RIGHT: seek(v, v->play_t + 1.0); break;
-    case GLFW_KEY_LEFT: seek(v, v->play_t - 1.0); break;
+    /* Playback runs on the bridge's thread; these only send it commands. */
+    case GLFW_KEY_SPACE:
+        if (v->motion)
+            ex_motion_pause(v->motion, !ex_motion_paused(v->motion));
+        break;
+    case GLFW_KEY_PERIOD:
+        if (v->motion)
+            ex_motion_step(v->motion, 1);
+        break;
+    case GLFW_KEY_COMMA:
+        if (v->motion) {
+            ex_motion_pause(v->motion, 1);
+            ex_motion_seek(v->motion, now - dt);
+        }
+        break;
+    case GLFW_KEY_HOME:
+        if (v->motion)
+            ex_motion_seek(v->motion, 0.0);
+        break;
+    case GLFW_KEY_RIGHT:
+    case GLFW_KEY_LEFT:
+        if (v->motion)
+            ex_motion_seek(v->motion, now + (key == GLFW_KEY_RIGHT ? 1.0 : -1.0));
+        break;
     default: break;
     }
 }
@@ -218,13 +224,8 @@ static void hud(viewer *v, int fw, int fh)
              ex_method_name(pose_get_method(v->sc.state)), name,
              v->sc.weight_joint >= 0 ? "  (weights)" : "");
     ex_draw_text(10, 10, 2, white, line, fw, fh);
-    if (v->motion) {
-        double dt = ex_motion_frame_time(v->motion);
-        snprintf(line, sizeof line, "%s  t %.2f s  frame %ld/%ld  %s", ex_motion_status(v->motion), v->play_t,
-                 dt > 0.0 ? (long)(v->play_t / dt + 0.5) : 0L, ex_motion_frame_count(v->motion),
-                 v->playing ? "playing" : "paused");
-        ex_draw_text(10, 30, 2, dim, line, fw, fh);
-    }
+    if (v->motion)
+        ex_draw_text(10, 30, 2, dim, ex_motion_status(v->motion), fw, fh);
     if (v->status[0])
         ex_draw_text(10, fh - 24, 2, dim, v->status, fw, fh);
     if (v->show_help) {
@@ -288,7 +289,6 @@ int main(int argc, char **argv)
 
     viewer v;
     memset(&v, 0, sizeof v);
-    v.speed = 1.0;
     v.show_help = 1;
     if (ex_scene_open(&v.sc, rig, err, sizeof err) < 0) {
         fprintf(stderr, "pose-view: %s\n", err);
@@ -315,7 +315,6 @@ int main(int argc, char **argv)
     if (source) {
         if (ex_motion_open(source, map, v.sc.rig, &v.motion, err, sizeof err) < 0)
             goto done;
-        v.playing = 1;
     }
     /* Check for a display before GLFW does, to say what is missing in plain words. */
     const char *display = getenv("DISPLAY"), *wayland = getenv("WAYLAND_DISPLAY");
@@ -354,20 +353,15 @@ int main(int argc, char **argv)
         ex_camera_frame(&v.cam, bmin, bmax, (float)width / (float)height);
     }
     v.joint = pose_rig_joint_count(v.sc.rig) > 1 ? 1 : 0;
-    double last = glfwGetTime(), fps_t = last, start = last, apply_sum = 0.0;
+    if (v.motion && ex_motion_start(v.motion, err, sizeof err) < 0)
+        goto done;
+    double fps_t = glfwGetTime(), start = fps_t, apply_sum = 0.0;
     int frames = 0;
     long total = 0;
     while (!glfwWindowShouldClose(win) && (!quit_after || total < quit_after)) {
         double now = glfwGetTime();
-        if (v.motion && v.playing) {
-            seek(&v, v.play_t + (now - last) * v.speed);
-            long n = ex_motion_frame_count(v.motion);
-            double dt = ex_motion_frame_time(v.motion);
-            if (n > 0 && dt > 0.0 && v.play_t >= (double)(n - 1) * dt)
-                v.play_t = 0.0; /* loop */
-        }
-        last = now;
-        if (v.motion && ex_motion_set_time(v.motion, v.sc.state, v.play_t, err, sizeof err) < 0)
+        /* The newest pose the bridge thread published, if any; never waits for it. */
+        if (v.motion && ex_motion_poll(v.motion, v.sc.state, err, sizeof err) < 0)
             snprintf(v.status, sizeof v.status, "%s", err);
         if (ex_scene_apply(&v.sc, err, sizeof err) < 0)
             goto done;
