@@ -1,8 +1,11 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* libFuzzer target for the rig loader: any bytes either load into a rig whose
  * every array can be read, or fail with a message; never a crash or an
- * out-of-bounds read. Loaded a second time with CRCs skipped, so mutations
+ * out-of-bounds read. Loaded a second time, borrowed and with CRCs skipped, so mutations
  * reach the structural and content checks instead of stopping at a CRC. */
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L /* posix_memalign; the fuzzer build does not define it */
+#endif
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -43,11 +46,20 @@ static void touch(const pose_rig *rig)
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    static const uint32_t flags[2] = {0, POSE_LOAD_SKIP_CRC};
+    /* Copy, then borrow (from a 64-byte aligned copy sized exactly, so any
+     * read past the end is caught by ASan), CRCs skipped. */
+    void *block = NULL;
+    if (size && posix_memalign(&block, 64, size) != 0)
+        return 0;
+    uint8_t *aligned = block;
+    if (size)
+        memcpy(aligned, data, size);
+    static const uint32_t flags[2] = {0, POSE_LOAD_SKIP_CRC | POSE_LOAD_BORROW};
     for (int i = 0; i < 2; i++) {
         pose_load_options o = {.flags = flags[i]};
         pose_rig *rig = NULL;
-        pose_status st = pose_rig_load_memory(size ? data : (const uint8_t *)"", size, &o, &rig);
+        const uint8_t *src = i == 0 || !aligned ? data : aligned;
+        pose_status st = pose_rig_load_memory(size ? src : (const uint8_t *)"", size, &o, &rig);
         if (st == POSE_OK) {
             touch(rig);
             pose_rig_free(rig);
@@ -55,5 +67,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             abort(); /* a failure must leave no rig and explain itself */
         }
     }
+    free(aligned);
     return 0;
 }

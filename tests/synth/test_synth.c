@@ -226,6 +226,94 @@ static void test_cor_clustered_close_to_exact(void **state)
     pose_synth_free(r);
 }
 
+/* The sparse implementation against the formula of design §2 written out
+ * densely over every tet, for a sample of blend vertices. */
+static void test_cor_exact_matches_formula(void **state)
+{
+    (void)state;
+    pose_synth_rig *r = bar();
+    const pose_rig_desc *d = pose_synth_desc(r);
+    const unsigned K = d->influences;
+    const size_t J = d->joint_count;
+    const double sigma2 = 0.1 * 0.1;
+    size_t checked = 0;
+    for (size_t p = 0; p < d->tet_vertex_count && checked < 40; p += 7) {
+        double wp[8] = {0};
+        for (unsigned k = 0; k < K; k++)
+            wp[d->weight_joints[p * K + k]] += d->weights[p * K + k];
+        if (d->weights[p * K + 1] == 0.0f)
+            continue;
+        double num[3] = {0, 0, 0}, den = 0.0;
+        for (size_t t = 0; t < d->tet_count; t++) {
+            const uint32_t *tv = &d->tets[4 * t];
+            double ws[8] = {0}, c[3] = {0, 0, 0};
+            for (int v = 0; v < 4; v++) {
+                for (unsigned k = 0; k < K; k++)
+                    ws[d->weight_joints[tv[v] * K + k]] += 0.25 * d->weights[tv[v] * K + k];
+                for (int i = 0; i < 3; i++)
+                    c[i] += 0.25 * d->tet_positions[3 * tv[v] + i];
+            }
+            double s = 0.0;
+            for (size_t i = 0; i < J; i++)
+                for (size_t j = 0; j < J; j++)
+                    if (i != j) {
+                        double e = wp[i] * ws[j] - ws[i] * wp[j];
+                        s += wp[i] * wp[j] * ws[i] * ws[j] * exp(-e * e / sigma2);
+                    }
+            const float *a = &d->tet_positions[3 * tv[0]];
+            double m[3][3];
+            for (int k = 0; k < 3; k++)
+                for (int i = 0; i < 3; i++)
+                    m[k][i] = (double)d->tet_positions[3 * tv[k + 1] + i] - a[i];
+            double vol = fabs(m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                              m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                              m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) / 6.0;
+            den += s * vol;
+            for (int i = 0; i < 3; i++)
+                num[i] += s * vol * c[i];
+        }
+        assert_true(den > 0.0);
+        for (int i = 0; i < 3; i++)
+            assert_float_equal(d->cor[3 * p + i], num[i] / den, 1e-5);
+        checked++;
+    }
+    assert_int_equal(checked, 40);
+    pose_synth_free(r);
+}
+
+/* Through a file and back, every array is bit-identical. */
+static void test_bar_file_round_trip(void **state)
+{
+    (void)state;
+    pose_synth_rig *r = bar();
+    const pose_rig_desc *d = pose_synth_desc(r);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/bar.rig", getenv("POSE_TEST_TMP") ? getenv("POSE_TEST_TMP")
+                                                                     : "/tmp");
+    assert_int_equal(pose_rig_write_file(d, path), POSE_OK);
+    pose_rig *rig;
+    assert_int_equal(pose_rig_load(path, &rig), POSE_OK);
+    pose_tet_info ti;
+    assert_int_equal(pose_rig_tet_info(rig, &ti), POSE_OK);
+    assert_memory_equal(ti.rest_positions, d->tet_positions, d->tet_vertex_count * 12);
+    assert_memory_equal(ti.tets, d->tets, d->tet_count * 16);
+    assert_memory_equal(ti.labels, d->tet_labels, d->tet_count * 2);
+    assert_memory_equal(ti.weights, d->weights, d->tet_vertex_count * d->influences * 4);
+    assert_memory_equal(ti.weight_joints, d->weight_joints, d->tet_vertex_count * d->influences * 2);
+    assert_memory_equal(ti.cor, d->cor, d->tet_vertex_count * 12);
+    for (size_t t = 0; t < d->tissue_count; t++) {
+        pose_tissue_info info;
+        assert_int_equal(pose_rig_tissue_info(rig, (int)t, &info), POSE_OK);
+        assert_memory_equal(info.rest_positions, d->tissues[t].positions,
+                            d->tissues[t].vertex_count * 12);
+        assert_memory_equal(info.triangles, d->tissues[t].triangles,
+                            d->tissues[t].triangle_count * 12);
+    }
+    assert_string_equal(pose_rig_metadata(rig), d->metadata);
+    pose_rig_free(rig);
+    pose_synth_free(r);
+}
+
 static void test_rigs_validate(void **state)
 {
     (void)state;
@@ -275,6 +363,8 @@ int main(void)
         cmocka_unit_test(test_cor_single_weight_is_rest_position),
         cmocka_unit_test(test_cor_symmetric_junction_on_axis),
         cmocka_unit_test(test_cor_clustered_close_to_exact),
+        cmocka_unit_test(test_cor_exact_matches_formula),
+        cmocka_unit_test(test_bar_file_round_trip),
         cmocka_unit_test(test_rigs_validate),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
