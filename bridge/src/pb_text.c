@@ -3,6 +3,7 @@
 
 #include <ctype.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -87,10 +88,48 @@ int pb_token_is_nocase(pb_token tk, const char *word)
     return 1;
 }
 
+/* Fast path for plain decimals ("-12.3456"): with at most 15 significant
+ * digits the mantissa and 10^k (k <= 22) are exact doubles, so one division
+ * rounds correctly (Clinger 1990). Anything else goes to strtod. */
+static int fast_decimal(const char *s, size_t n, double *out)
+{
+    static const double pow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+                                     1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+    size_t i = 0;
+    int neg = 0;
+    if (s[0] == '-' || s[0] == '+')
+        neg = s[i++] == '-';
+    uint64_t m = 0;
+    int digits = 0, frac = 0, dot = 0, any = 0;
+    for (; i < n; i++) {
+        char c = s[i];
+        if (c >= '0' && c <= '9') {
+            any = 1;
+            if (m == 0 && c == '0' && !dot)
+                continue; /* leading zeros */
+            if (++digits > 15)
+                return -1;
+            m = m * 10 + (uint64_t)(c - '0');
+            frac += dot;
+        } else if (c == '.' && !dot) {
+            dot = 1;
+        } else {
+            return -1;
+        }
+    }
+    if (!any)
+        return -1;
+    double v = (double)m / pow10[frac];
+    *out = neg ? -v : v;
+    return 0;
+}
+
 int pb_token_double(pb_token tk, double *out)
 {
     if (tk.n == 0 || tk.n > 64)
         return -1;
+    if (fast_decimal(tk.s, tk.n, out) == 0)
+        return 0;
     /* strtod stops at the token's end because tokens end at whitespace or
      * the buffer's terminating NUL. */
     char *e;

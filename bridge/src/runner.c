@@ -2,6 +2,9 @@
 #include "runner.h"
 
 #include <pthread.h>
+#if defined(__linux__)
+#include <sys/prctl.h>
+#endif
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -90,9 +93,19 @@ static int publish(pb_runner *r, pb_pose *back, int64_t lag_ns)
     return bad;
 }
 
+/* Linux rounds timed waits up by the thread's timer slack (50 us by
+ * default); ticks want their deadline, not a coalesced wake-up. */
+static void tighten_timer_slack(void)
+{
+#if defined(__linux__) && defined(PR_SET_TIMERSLACK)
+    prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
+#endif
+}
+
 static void *clip_thread(void *arg)
 {
     pb_runner *r = arg;
+    tighten_timer_slack();
     double next = r->opt.start_s, first = r->opt.start_s;
     pb_clock_start(&r->clock, r->speed, next, pb_now_ns());
     if (r->paused)

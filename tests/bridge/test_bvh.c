@@ -4,6 +4,7 @@
 #include "bridge_test.h"
 #include "mocap.h"
 #include "pb_math.h"
+#include "pb_text.h"
 
 static const char *HIER =
     "HIERARCHY\n"
@@ -263,6 +264,47 @@ static void test_euler_round_trip(void **state)
         }
 }
 
+/* the reader's fast decimal path must round exactly like strtod */
+static void test_number_parsing_matches_strtod(void **state)
+{
+    (void)state;
+    unsigned x = 12345;
+    char buf[64];
+    for (int i = 0; i < 200000; i++) {
+        x = x * 1103515245u + 12345u;
+        int digits = 1 + (int)(x % 15), point = (int)((x >> 8) % (unsigned)(digits + 1));
+        size_t n = 0;
+        if (x & 0x10000)
+            buf[n++] = '-';
+        for (int d = 0; d < digits; d++) {
+            if (d == point && d > 0)
+                buf[n++] = '.';
+            x = x * 1103515245u + 12345u;
+            buf[n++] = (char)('0' + (x >> 16) % 10);
+        }
+        buf[n] = '\0';
+        pb_token tk = {buf, n, 1};
+        double v;
+        assert_int_equal(pb_token_double(tk, &v), 0);
+        if (v != strtod(buf, NULL))
+            fail_msg("'%s' parsed as %.17g, strtod gives %.17g", buf, v, strtod(buf, NULL));
+    }
+    const char *bad[] = {".", "-", "1.2.3", "1e", "0x", "--1", "1,5"};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        pb_token tk = {bad[i], strlen(bad[i]), 1};
+        double v;
+        assert_int_equal(pb_token_double(tk, &v), -1);
+    }
+    const char *odd[] = {"1e3", "-2.5E-2", "0x10", "+7", "1."};
+    const double want[] = {1000, -0.025, 16, 7, 1};
+    for (size_t i = 0; i < sizeof odd / sizeof odd[0]; i++) {
+        pb_token tk = {odd[i], strlen(odd[i]), 1};
+        double v;
+        assert_int_equal(pb_token_double(tk, &v), 0);
+        assert_near(v, want[i], 0);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -275,6 +317,7 @@ int main(void)
         cmocka_unit_test(test_hand_computed_fk),
         cmocka_unit_test(test_crlf_and_trailing_blanks),
         cmocka_unit_test(test_euler_round_trip),
+        cmocka_unit_test(test_number_parsing_matches_strtod),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

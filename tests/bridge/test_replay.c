@@ -106,8 +106,10 @@ static int cmp_i64(const void *x, const void *y)
     return (a > b) - (a < b);
 }
 
-/* Run `ticks` poses at `speed`, reading like a host; returns the wall time
- * between the first and last pose and checks their order. */
+/* Run `ticks` poses at `speed`, reading like a host. Checks the order of
+ * what the host sees, that no tick is early, and that the tick deadlines
+ * (wake-up time minus measured lag) follow the recorded timing exactly.
+ * Returns the median lateness in seconds. */
 static double run_realtime(fixture *f, double speed, long ticks, int afap)
 {
     pb_runner *r;
@@ -115,15 +117,16 @@ static double run_realtime(fixture *f, double speed, long ticks, int afap)
     pb_runner_options o = {.speed = speed, .afap = afap, .max_ticks = ticks};
     if (pb_runner_start_clip(f->clip, f->rig, f->map, &o, &r, &err) != POSE_OK)
         fail_msg("%s", err.message);
-    int64_t first = 0, last = 0;
-    long last_frame = -1;
+    int64_t first = 0;
+    long first_frame = -1, last_frame = -1;
     for (;;) {
         int fresh;
         const pb_pose *p = pb_runner_latest(r, &fresh);
         if (fresh) {
-            if (!first)
+            if (first_frame < 0) {
                 first = p->t_ns;
-            last = p->t_ns;
+                first_frame = p->frame;
+            }
             assert_true(p->frame > last_frame); /* frames only move forward */
             last_frame = p->frame;
         }
@@ -132,7 +135,7 @@ static double run_realtime(fixture *f, double speed, long ticks, int afap)
     }
     const pb_pose *p = pb_runner_latest(r, NULL);
     assert_int_equal(p->frame, ticks - 1);
-    last = p->t_ns;
+    int64_t last = p->t_ns;
     pb_runner_stats st;
     pb_runner_stats_get(r, &st);
     assert_int_equal(st.ticks, (uint64_t)ticks);
@@ -142,31 +145,32 @@ static double run_realtime(fixture *f, double speed, long ticks, int afap)
     assert_int_equal(n, (size_t)ticks);
     for (size_t i = 0; i < n; i++)
         assert_true(lags[i] >= 0); /* never early: deadlines are absolute */
+    if (!afap && first_frame >= 0 && first_frame < ticks - 1) {
+        /* tick k shows frame k; its deadline is its wake-up minus its lag */
+        double span = (double)((last - lags[ticks - 1]) - (first - lags[first_frame])) * 1e-9;
+        double want = (double)(ticks - 1 - first_frame) * f->clip->frame_time / speed;
+        assert_near(span, want, 2e-6);
+    }
     qsort(lags, n, sizeof *lags, cmp_i64);
     if (!afap)
         print_message("x%g: %ld ticks, lag p50 %.3f ms, p99 %.3f ms, max %.3f ms\n", speed, ticks,
                       (double)lags[n / 2] * 1e-6, (double)lags[n * 99 / 100] * 1e-6, (double)lags[n - 1] * 1e-6);
     assert_int_equal(pb_runner_stop(r, &err), POSE_OK);
-    return (double)(last - first) * 1e-9;
+    if (afap)
+        return (double)(last - first) * 1e-9;
+    return (double)lags[n / 2] * 1e-9;
 }
 
 static void test_realtime_pacing(void **state)
 {
     fixture *f = *state;
     const double ft = f->clip->frame_time;
-    /* 60 frames at x1 span 59 frame times of wall clock: never less (ticks
-     * wait for absolute deadlines), and late by at most a loaded machine's
-     * scheduling delay. */
-    double span = run_realtime(f, 1.0, 60, 0);
-    print_message("x1: 59 frames took %.3f ms, recorded %.3f ms (error %+.3f ms)\n", span * 1e3, 59 * ft * 1e3,
-                  (span - 59 * ft) * 1e3);
-    assert_true(span >= 59 * ft - 0.002);
-    assert_true(span <= 59 * ft + 0.100);
-    span = run_realtime(f, 2.0, 60, 0);
-    assert_true(span >= 59 * ft / 2 - 0.002);
-    assert_true(span <= 59 * ft / 2 + 0.100);
+    /* x1 and x2: deadlines follow the recorded timing (checked inside);
+     * the median wake-up is late by scheduling noise only, not by a frame */
+    assert_true(run_realtime(f, 1.0, 60, 0) < ft);
+    assert_true(run_realtime(f, 2.0, 60, 0) < ft / 2);
     /* as fast as possible: 600 frames (5 s of clip) in well under real time */
-    span = run_realtime(f, 1.0, 600, 1);
+    double span = run_realtime(f, 1.0, 600, 1);
     assert_true(span < 599 * ft / 4);
 }
 
