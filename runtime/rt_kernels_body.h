@@ -36,27 +36,82 @@ static POSE__INLINE void joint_offsets(const pose__skin_mesh *m, size_t b, size_
          *(const pose__v8u16 *)((m)->weights + ((b) * (m)->influences + (k)) * POSE__BLOCK), \
          pose__v8f) * WSCALE)
 
+/* Write the lanes of block b as xyz triples at out + 24 b (only the lanes
+ * below `count`). With AVX2 a full block is three aligned 32-byte stores,
+ * non-temporal when `stream` (outputs nobody reads during pose_apply). */
 static POSE__INLINE void store_lanes(float *restrict out, size_t b, size_t count,
                                      const pose__v8f *px, const pose__v8f *py,
-                                     const pose__v8f *pz)
+                                     const pose__v8f *pz, int stream)
 {
-    const pose__v8f x = *px, y = *py, z = *pz;
     size_t n = count - b * POSE__BLOCK;
     float *o = out + 3 * POSE__BLOCK * b;
-    if (n >= 8) {
-        for (int l = 0; l < 8; l++) {
-            o[3 * l + 0] = x[l];
-            o[3 * l + 1] = y[l];
-            o[3 * l + 2] = z[l];
+#ifdef __AVX2__
+    if (n >= 8 && ((uintptr_t)o & 31u) == 0) {
+        const __m256 x = (__m256)*px, y = (__m256)*py, z = (__m256)*pz;
+        const __m256i i0 = _mm256_setr_epi32(0, 0, 0, 1, 1, 1, 2, 2);
+        const __m256i i1 = _mm256_setr_epi32(2, 3, 3, 3, 4, 4, 4, 5);
+        const __m256i i2 = _mm256_setr_epi32(5, 5, 6, 6, 6, 7, 7, 7);
+        __m256 a = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(x, i0),
+                                                   _mm256_permutevar8x32_ps(y, i0), 0x92),
+                                   _mm256_permutevar8x32_ps(z, i0), 0x24);
+        __m256 c = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(x, i1),
+                                                   _mm256_permutevar8x32_ps(y, i1), 0x24),
+                                   _mm256_permutevar8x32_ps(z, i1), 0x49);
+        __m256 e = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(x, i2),
+                                                   _mm256_permutevar8x32_ps(y, i2), 0x49),
+                                   _mm256_permutevar8x32_ps(z, i2), 0x92);
+        if (stream) {
+            _mm256_stream_ps(o, a);
+            _mm256_stream_ps(o + 8, c);
+            _mm256_stream_ps(o + 16, e);
+        } else {
+            _mm256_store_ps(o, a);
+            _mm256_store_ps(o + 8, c);
+            _mm256_store_ps(o + 16, e);
         }
         return;
     }
+#else
+    (void)stream;
+#endif
+    const pose__v8f x = *px, y = *py, z = *pz;
+    if (n > 8)
+        n = 8;
     for (size_t l = 0; l < n; l++) {
         o[3 * l + 0] = x[l];
         o[3 * l + 1] = y[l];
         o[3 * l + 2] = z[l];
     }
 }
+
+/* x, y, z of the tet vertices at tp + idx[l] (idx = 3 * vertex index). */
+#ifdef __AVX2__
+/* One 16-byte load per lane (its 4th float belongs to the next vertex, or
+ * to the slack the caller leaves after the array), then a transpose. */
+#define LOAD_XYZ(tp, idx, X, Y, Z)                                                  \
+    do {                                                                            \
+        __m256 r0_ = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((tp) + (idx)[0])), \
+                                          _mm_loadu_ps((tp) + (idx)[4]), 1);        \
+        __m256 r1_ = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((tp) + (idx)[1])), \
+                                          _mm_loadu_ps((tp) + (idx)[5]), 1);        \
+        __m256 r2_ = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((tp) + (idx)[2])), \
+                                          _mm_loadu_ps((tp) + (idx)[6]), 1);        \
+        __m256 r3_ = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((tp) + (idx)[3])), \
+                                          _mm_loadu_ps((tp) + (idx)[7]), 1);        \
+        __m256 t0_ = _mm256_unpacklo_ps(r0_, r1_), t1_ = _mm256_unpackhi_ps(r0_, r1_); \
+        __m256 t2_ = _mm256_unpacklo_ps(r2_, r3_), t3_ = _mm256_unpackhi_ps(r2_, r3_); \
+        (X) = (pose__v8f)_mm256_shuffle_ps(t0_, t2_, 0x44);                         \
+        (Y) = (pose__v8f)_mm256_shuffle_ps(t0_, t2_, 0xEE);                         \
+        (Z) = (pose__v8f)_mm256_shuffle_ps(t1_, t3_, 0x44);                         \
+    } while (0)
+#else
+#define LOAD_XYZ(tp, idx, X, Y, Z)                                                  \
+    do {                                                                            \
+        (X) = V8_GATHER(tp, idx, 0);                                                \
+        (Y) = V8_GATHER(tp, idx, 1);                                                \
+        (Z) = V8_GATHER(tp, idx, 2);                                                \
+    } while (0)
+#endif
 
 void POSE__KV(pose__skin_blocks)(int method, const pose__skin_mesh *m,
                                  const pose__skin_joint *palette, size_t begin, size_t end,
@@ -160,7 +215,7 @@ void POSE__KV(pose__skin_blocks)(int method, const pose__skin_mesh *m,
             oy = vy + (ry + dy);
             oz = vz + (rz + dz);
         }
-        store_lanes(out, b, m->vertex_count, &ox, &oy, &oz);
+        store_lanes(out, b, m->vertex_count, &ox, &oy, &oz, 0);
     }
 }
 
@@ -177,21 +232,21 @@ void POSE__KV(pose__transfer_blocks)(const pose__transfer_mesh *m, const float *
             i2[l] = (int32_t)(3 * tv[16 + l]);
             i3[l] = (int32_t)(3 * tv[24 + l]);
         }
-        const pose__v8f v0x = V8_GATHER(tp, i0, 0), v0y = V8_GATHER(tp, i0, 1),
-                        v0z = V8_GATHER(tp, i0, 2);
-        const pose__v8f e1x = V8_GATHER(tp, i1, 0) - v0x, e1y = V8_GATHER(tp, i1, 1) - v0y,
-                        e1z = V8_GATHER(tp, i1, 2) - v0z;
-        const pose__v8f e2x = V8_GATHER(tp, i2, 0) - v0x, e2y = V8_GATHER(tp, i2, 1) - v0y,
-                        e2z = V8_GATHER(tp, i2, 2) - v0z;
-        const pose__v8f e3x = V8_GATHER(tp, i3, 0) - v0x, e3y = V8_GATHER(tp, i3, 1) - v0y,
-                        e3z = V8_GATHER(tp, i3, 2) - v0z;
+        pose__v8f v0x, v0y, v0z, e1x, e1y, e1z, e2x, e2y, e2z, e3x, e3y, e3z;
+        LOAD_XYZ(tp, i0, v0x, v0y, v0z);
+        LOAD_XYZ(tp, i1, e1x, e1y, e1z);
+        LOAD_XYZ(tp, i2, e2x, e2y, e2z);
+        LOAD_XYZ(tp, i3, e3x, e3y, e3z);
+        e1x -= v0x; e1y -= v0y; e1z -= v0z;
+        e2x -= v0x; e2y -= v0y; e2z -= v0z;
+        e3x -= v0x; e3y -= v0y; e3z -= v0z;
         const float *bb = m->bary + 3 * POSE__BLOCK * b;
         const pose__v8f b1 = *(const pose__v8f *)bb, b2 = *(const pose__v8f *)(bb + 8),
                         b3 = *(const pose__v8f *)(bb + 16);
         const pose__v8f px = v0x + (b1 * e1x + b2 * e2x + b3 * e3x);
         const pose__v8f py = v0y + (b1 * e1y + b2 * e2y + b3 * e3y);
         const pose__v8f pz = v0z + (b1 * e1z + b2 * e2z + b3 * e3z);
-        store_lanes(pos, b, m->vertex_count, &px, &py, &pz);
+        store_lanes(pos, b, m->vertex_count, &px, &py, &pz, 1);
         if (!nrm)
             continue;
         const int16_t *kb = m->normal_key + 3 * POSE__BLOCK * b;
@@ -211,6 +266,9 @@ void POSE__KV(pose__transfer_blocks)(const pose__transfer_mesh *m, const float *
         nx *= s;
         ny *= s;
         nz *= s;
-        store_lanes(nrm, b, m->vertex_count, &nx, &ny, &nz);
+        store_lanes(nrm, b, m->vertex_count, &nx, &ny, &nz, 1);
     }
+#ifdef __AVX2__
+    _mm_sfence(); /* order the streaming stores before the pool's hand-back */
+#endif
 }

@@ -28,7 +28,9 @@ typedef struct pose__transfer_mesh {
 } pose__transfer_mesh;
 
 /** Positions (and normals when nrm != NULL) of blocks [begin, end); xyz
- *  interleaved at pos/nrm + 3 * vertex; padding lanes are not written. */
+ *  interleaved at pos/nrm + 3 * vertex; padding lanes are not written.
+ *  tet_positions must stay readable for 16 bytes past its last vertex
+ *  (vertices are loaded 16 bytes at a time). */
 void pose__transfer(const pose__transfer_mesh *mesh, const float *tet_positions, size_t begin,
                     size_t end, float *pos, float *nrm);
 

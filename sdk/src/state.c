@@ -106,7 +106,7 @@ pose_status pose_state_create_ex(const pose_rig *rig, const pose_state_options *
     size_t off_world = off_skin + align64(nj * sizeof(pose__xform));
     size_t off_palette = off_world + align64(nj * sizeof(pose__xform));
     size_t off_tet = off_palette + align64(nj * sizeof(pose__skin_joint));
-    size_t off_pos = off_tet + align64(3 * nv * sizeof(float));
+    size_t off_pos = off_tet + align64(3 * nv * sizeof(float) + 16); /* slack: rt_transfer.h */
     size_t off_nrm = off_pos + align64(3 * nt * sizeof(float));
     size_t size = off_nrm + align64(3 * nt * sizeof(float));
 

@@ -16,6 +16,97 @@
 #include "rt_transfer.h"
 #include "test_math.h"
 
+/* ---- blocked layouts (as rig_prepare builds them), from per-vertex arrays */
+typedef struct packed_skin {
+    pose__skin_mesh mesh;
+    float *rest, *cor;
+    uint8_t *active, *j8;
+    uint16_t *j16, *w;
+} packed_skin;
+
+static void *zalloc(size_t n)
+{
+    void *p = aligned_alloc(64, (n + 64 + 63) & ~(size_t)63);
+    assert_non_null(p);
+    memset(p, 0, (n + 64 + 63) & ~(size_t)63);
+    return p;
+}
+
+static packed_skin pack_skin(size_t n, unsigned K, const float *rest, const float *cor,
+                             const uint16_t *joints, const uint16_t *weights, int wide)
+{
+    packed_skin p;
+    size_t nb = (n + 7) / 8;
+    p.rest = zalloc(nb * 24 * sizeof(float));
+    p.cor = zalloc(nb * 24 * sizeof(float));
+    p.active = zalloc(nb);
+    p.j8 = zalloc(nb * K * 8);
+    p.j16 = zalloc(nb * K * 8 * 2);
+    p.w = zalloc(nb * K * 8 * 2);
+    for (size_t b = 0; b < nb; b++) {
+        p.active[b] = 1;
+        for (size_t l = 0; l < 8; l++) {
+            size_t i = b * 8 + l, src = i < n ? i : 0;
+            for (int c = 0; c < 3; c++) {
+                p.rest[(b * 3 + (size_t)c) * 8 + l] = rest[3 * src + (size_t)c];
+                p.cor[(b * 3 + (size_t)c) * 8 + l] = cor[3 * src + (size_t)c];
+            }
+            for (unsigned k = 0; k < K; k++) {
+                size_t at = (b * K + k) * 8 + l;
+                p.j8[at] = (uint8_t)joints[src * K + k];
+                p.j16[at] = joints[src * K + k];
+                p.w[at] = weights[src * K + k];
+                if (weights[src * K + k] && k + 1 > p.active[b])
+                    p.active[b] = (uint8_t)(k + 1);
+            }
+        }
+    }
+    p.mesh = (pose__skin_mesh){.vertex_count = n, .block_count = nb, .influences = K,
+                               .rest = p.rest, .cor = p.cor, .active = p.active,
+                               .joints8 = wide ? NULL : p.j8, .joints16 = wide ? p.j16 : NULL,
+                               .weights = p.w};
+    return p;
+}
+
+static void free_skin(packed_skin *p)
+{
+    free(p->rest); free(p->cor); free(p->active); free(p->j8); free(p->j16); free(p->w);
+}
+
+typedef struct packed_transfer {
+    pose__transfer_mesh mesh;
+    uint32_t *tv;
+    float *bary;
+    int16_t *key;
+} packed_transfer;
+
+static packed_transfer pack_transfer(size_t n, const uint32_t *tv4, const float *b3,
+                                     const int16_t *key3)
+{
+    packed_transfer p;
+    size_t nb = (n + 7) / 8;
+    p.tv = zalloc(nb * 32 * sizeof(uint32_t));
+    p.bary = zalloc(nb * 24 * sizeof(float));
+    p.key = zalloc(nb * 24 * sizeof(int16_t));
+    for (size_t i = 0; i < n; i++) {
+        size_t b = i / 8, l = i % 8;
+        for (size_t c = 0; c < 4; c++)
+            p.tv[(b * 4 + c) * 8 + l] = tv4[4 * i + c];
+        for (size_t c = 0; c < 3; c++) {
+            p.bary[(b * 3 + c) * 8 + l] = b3[3 * i + c];
+            p.key[(b * 3 + c) * 8 + l] = key3[3 * i + c];
+        }
+    }
+    p.mesh = (pose__transfer_mesh){.vertex_count = n, .block_count = nb, .tet_vertices = p.tv,
+                                   .bary = p.bary, .normal_key = p.key};
+    return p;
+}
+
+static void free_transfer(packed_transfer *p)
+{
+    free(p->tv); free(p->bary); free(p->key);
+}
+
 /* Two joints holding the same rotation as q and -q: a 50/50 blend must be
  * that rotation, not a collapse (the antipodality DQS and CoR must handle). */
 static void test_blend_antipodal_quaternions(void **unused)
@@ -35,13 +126,12 @@ static void test_blend_antipodal_quaternions(void **unused)
     pose__skin_palette(2, x, pal);
     const float rest[6] = {1.0f, 2.0f, 3.0f, -0.5f, 0.25f, 4.0f};
     const float cor[6] = {0.5f, 0.5f, 0.5f, 0.0f, 1.0f, 0.0f};
-    const uint8_t joints[4] = {0, 1, 1, 0};
+    const uint16_t joints[4] = {0, 1, 1, 0};
     const uint16_t weights[4] = {16384, 16384, 16384, 16384};
-    pose__skin_mesh mesh = {.vertex_count = 2, .influences = 2, .rest = rest, .cor = cor,
-                            .joints8 = joints, .weights = weights};
+    packed_skin ps = pack_skin(2, 2, rest, cor, joints, weights, 0);
     for (int method = POSE__SKIN_DQS; method <= POSE__SKIN_COR; method++) {
         float out[6];
-        pose__skin(method, &mesh, pal, 0, 2, out);
+        pose__skin(method, &ps.mesh, pal, 0, 1, out);
         for (int v = 0; v < 2; v++) {
             double p[3] = {rest[3 * v], rest[3 * v + 1], rest[3 * v + 2]}, e[3];
             dq_rot(e, q, p);
@@ -49,6 +139,7 @@ static void test_blend_antipodal_quaternions(void **unused)
                 assert_near(out[3 * v + k], e[k] + t[k], 1e-5);
         }
     }
+    free_skin(&ps);
 }
 
 /* LBS, DQS and CoR agree for a vertex bound to one joint (rigid), and the
@@ -69,24 +160,21 @@ static void test_single_joint_rigid_all_methods(void **unused)
     pose__skin_joint pal[3];
     pose__skin_palette(3, x, pal);
     const float rest[3] = {0.7f, -1.1f, 2.5f}, cor[3] = {9.0f, 9.0f, 9.0f};
-    const uint8_t j8[3] = {2, 0, 1};
     const uint16_t j16[3] = {2, 0, 1};
     const uint16_t w[3] = {32768, 0, 0};
-    pose__skin_mesh m8 = {.vertex_count = 1, .influences = 3, .rest = rest, .cor = cor,
-                          .joints8 = j8, .weights = w};
-    pose__skin_mesh m16 = m8;
-    m16.joints8 = NULL;
-    m16.joints16 = j16;
+    packed_skin p8 = pack_skin(1, 3, rest, cor, j16, w, 0), p16 = pack_skin(1, 3, rest, cor, j16, w, 1);
     double xq[4] = {x[2].q[0], x[2].q[1], x[2].q[2], x[2].q[3]}, p[3] = {rest[0], rest[1], rest[2]}, e[3];
     dq_rot(e, xq, p);
     for (int method = 0; method < 3; method++) {
         float a[3], b[3];
-        pose__skin(method, &m8, pal, 0, 1, a);
-        pose__skin(method, &m16, pal, 0, 1, b);
+        pose__skin(method, &p8.mesh, pal, 0, 1, a);
+        pose__skin(method, &p16.mesh, pal, 0, 1, b);
         assert_memory_equal(a, b, sizeof a);
         for (int k = 0; k < 3; k++)
             assert_near(a[k], e[k] + x[2].t[k], 1e-5);
     }
+    free_skin(&p8);
+    free_skin(&p16);
 }
 
 /* Under an affine map of the tet vertices, barycentric transfer reproduces
@@ -98,7 +186,7 @@ static void test_transfer_affine_exact(void **unused)
     const float tet[12] = {0.1f, 0.0f, 0.2f, 1.3f, 0.1f, 0.0f, 0.2f, 0.9f, 0.1f, 0.3f, 0.2f, 1.1f};
     const double A[3][3] = {{1.2, 0.3, -0.4}, {0.1, 0.8, 0.5}, {-0.2, 0.4, 1.5}};
     const double off[3] = {2.0, -1.0, 0.5};
-    float moved[12];
+    float moved[16] = {0}; /* 16 bytes of slack after the 4 vertices */
     for (int v = 0; v < 4; v++)
         for (int r = 0; r < 3; r++)
             moved[3 * v + r] = (float)(A[r][0] * tet[3 * v] + A[r][1] * tet[3 * v + 1] +
@@ -152,9 +240,9 @@ static void test_transfer_affine_exact(void **unused)
         for (int k = 0; k < 3; k++)
             key[3 * i + k] = (int16_t)lround((det < 0 ? -m[k] : m[k]) / big * 32767.0);
     }
-    pose__transfer_mesh mesh = {.vertex_count = N, .tet_vertices = tv, .bary = bary, .normal_key = key};
-    float pos[3 * N], nrm[3 * N];
-    pose__transfer(&mesh, moved, 0, N, pos, nrm);
+    packed_transfer pt = pack_transfer(N, tv, bary, key);
+    float *pos = zalloc(3 * N * sizeof(float)), *nrm = zalloc(3 * N * sizeof(float));
+    pose__transfer(&pt.mesh, moved, 0, pt.mesh.block_count, pos, nrm);
     for (int i = 0; i < N; i++) {
         double nn[3], l = 0;
         for (int r = 0; r < 3; r++) {
@@ -169,9 +257,96 @@ static void test_transfer_affine_exact(void **unused)
             assert_near(nrm[3 * i + r], nn[r] / sqrt(l), 2e-4);
     }
     /* positions only (normals skipped) give the same positions */
-    float pos2[3 * N];
-    pose__transfer(&mesh, moved, 0, N, pos2, NULL);
-    assert_memory_equal(pos, pos2, sizeof pos);
+    float *pos2 = zalloc(3 * N * sizeof(float));
+    pose__transfer(&pt.mesh, moved, 0, pt.mesh.block_count, pos2, NULL);
+    assert_memory_equal(pos, pos2, 3 * N * sizeof(float));
+    free(pos);
+    free(pos2);
+    free(nrm);
+    free_transfer(&pt);
+}
+
+/* The generic and AVX2 variants give bit-identical results (all methods,
+ * multi-influence blocks, a partial last block, unaligned outputs). */
+static void test_variants_identical(void **unused)
+{
+    (void)unused;
+    enum { NV = 203, NJ = 9, K = 4, NT = 157 };
+    float rest[3 * NV], cor[3 * NV], tp[3 * NV + 4];
+    uint16_t joints[K * NV], weights[K * NV];
+    unsigned s = 99;
+    for (size_t i = 0; i < 3 * NV; i++) {
+        s = s * 1664525u + 1013904223u;
+        rest[i] = (float)(s >> 8) / 16777216.0f * 2.0f - 1.0f;
+        cor[i] = rest[i] * 0.5f;
+    }
+    for (size_t i = 0; i < NV; i++) {
+        unsigned left = 32768;
+        for (unsigned k = 0; k < K; k++) {
+            s = s * 1664525u + 1013904223u;
+            joints[K * i + k] = (uint16_t)((s >> 10) % NJ);
+            unsigned w = k + 1 == K ? left : (i % 3 == 0 ? (k == 0 ? left : 0) : left / 2);
+            weights[K * i + k] = (uint16_t)w;
+            left -= w;
+        }
+    }
+    pose__xform x[NJ];
+    for (int j = 0; j < NJ; j++) {
+        double q[4];
+        dq_axis(q, 1.0, j - 4.0, 0.5, 37.0 * j - 150.0);
+        for (int k = 0; k < 4; k++)
+            x[j].q[k] = (float)q[k];
+        x[j].t[0] = 0.1f * j; x[j].t[1] = -0.2f; x[j].t[2] = 0.05f * j;
+    }
+    pose__skin_joint pal[NJ];
+    pose__skin_palette(NJ, x, pal);
+    packed_skin ps = pack_skin(NV, K, rest, cor, joints, weights, 0);
+    uint32_t tv[4 * NT];
+    float bary[3 * NT];
+    int16_t key[3 * NT];
+    for (size_t i = 0; i < NT; i++) {
+        for (int c = 0; c < 4; c++) {
+            s = s * 1664525u + 1013904223u;
+            tv[4 * i + (size_t)c] = (s >> 8) % NV;
+        }
+        for (int c = 0; c < 3; c++) {
+            s = s * 1664525u + 1013904223u;
+            bary[3 * i + (size_t)c] = (float)(s >> 8) / 16777216.0f * 0.5f;
+            key[3 * i + (size_t)c] = (int16_t)((int)(s >> 16) - 32768);
+        }
+    }
+    packed_transfer pt = pack_transfer(NT, tv, bary, key);
+    float *out[2][3], *aligned[2][3];
+    for (int v = 0; v < 2; v++) {
+        pose__kernels_force_generic(v);
+        for (int method = 0; method < 3; method++) {
+            out[v][method] = zalloc(3 * NV * sizeof(float) + 3 * 2 * NT * sizeof(float) + 64);
+            float *o = out[v][method];
+            pose__skin(method, &ps.mesh, pal, 0, ps.mesh.block_count, o);
+            memcpy(tp, o, 3 * NV * sizeof(float));
+            /* odd offsets: outputs not 32-byte aligned take the lane path */
+            pose__transfer(&pt.mesh, tp, 0, pt.mesh.block_count, o + 3 * NV + 1,
+                           o + 3 * NV + 3 * NT + 1);
+            /* and aligned ones take the vector (streaming) path */
+            aligned[v][method] = zalloc(2 * 3 * NT * sizeof(float) + 64);
+            float *a = aligned[v][method];
+            pose__transfer(&pt.mesh, tp, 0, pt.mesh.block_count, a, a + ((3 * NT + 15) & ~15));
+        }
+    }
+    pose__kernels_force_generic(0);
+    for (int method = 0; method < 3; method++) {
+        assert_memory_equal(out[0][method], out[1][method],
+                            3 * NV * sizeof(float) + 3 * 2 * NT * sizeof(float) + 4);
+        assert_memory_equal(aligned[0][method], aligned[1][method], 2 * 3 * NT * sizeof(float));
+        /* the unaligned and aligned paths agree too */
+        assert_memory_equal(aligned[1][method], out[1][method] + 3 * NV + 1, 3 * NT * sizeof(float));
+        free(out[0][method]);
+        free(out[1][method]);
+        free(aligned[0][method]);
+        free(aligned[1][method]);
+    }
+    free_skin(&ps);
+    free_transfer(&pt);
 }
 
 /* Decomposition inverts composition for all orders, at gimbal lock too. */
@@ -214,6 +389,7 @@ int main(void)
         cmocka_unit_test(test_single_joint_rigid_all_methods),
         cmocka_unit_test(test_transfer_affine_exact),
         cmocka_unit_test(test_euler_round_trip),
+        cmocka_unit_test(test_variants_identical),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
