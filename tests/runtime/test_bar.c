@@ -106,8 +106,8 @@ static void test_twist_135_cross_section(void **unused)
         /* the joint's local frame may be rotated: express the model-space x axis in it */
         double rc[4] = {-j2.rest_model.rotation[0], -j2.rest_model.rotation[1],
                         -j2.rest_model.rotation[2], j2.rest_model.rotation[3]}, ax[3];
-        const double x[3] = {1, 0, 0};
-        dq_rot(ax, rc, x);
+        const double xaxis[3] = {1, 0, 0};
+        dq_rot(ax, rc, xaxis);
         dq_axis(q, ax[0], ax[1], ax[2], 135.0);
         const float qf[4] = {(float)q[0], (float)q[1], (float)q[2], (float)q[3]};
         assert_true(pose_set_joint(st, 2, qf) >= 0);
