@@ -79,12 +79,22 @@ static int wanted(const pb_can_config *cfg, const char *name, unsigned char *use
     return 0;
 }
 
+/* Truncating copy (names longer than the field are cut, not rejected). */
+static void copy_str(char *dst, size_t size, const char *src)
+{
+    size_t n = strlen(src);
+    if (n >= size)
+        n = size - 1;
+    memcpy(dst, src, n);
+    dst[n] = '\0';
+}
+
 static int32_t add_channel(pb_can_decoder *d, const char *name, const char *unit, double lo, double hi)
 {
     pb_channel *c = &d->channels[d->channel_count];
     memset(c, 0, sizeof *c);
-    snprintf(c->name, sizeof c->name, "%s", name);
-    snprintf(c->unit, sizeof c->unit, "%s", unit);
+    copy_str(c->name, sizeof c->name, name);
+    copy_str(c->unit, sizeof c->unit, unit);
     /* DBC files write [0|0] for "no range": report the range as unknown then. */
     c->min = lo;
     c->max = hi;
@@ -169,7 +179,7 @@ pose_status pb_can_decoder_create(const pb_can_config *cfg, pb_can_decoder **out
         n->co = c;
         n->id = c->node;
         if (c->name)
-            snprintf(n->name, sizeof n->name, "%s", c->name);
+            copy_str(n->name, sizeof n->name, c->name);
         else
             snprintf(n->name, sizeof n->name, "node%u", c->node);
         char ch[128];
@@ -206,7 +216,7 @@ pose_status pb_can_decoder_create(const pb_can_config *cfg, pb_can_decoder **out
         n->kind = NODE_J1939;
         n->id = c->address;
         if (c->name)
-            snprintf(n->name, sizeof n->name, "%s", c->name);
+            copy_str(n->name, sizeof n->name, c->name);
         else
             snprintf(n->name, sizeof n->name, "sa%02X", c->address);
         char ch[128];
@@ -255,7 +265,7 @@ pose_status pb_can_decoder_create(const pb_can_config *cfg, pb_can_decoder **out
             n->kind = NODE_DBC;
             n->msg = m;
             n->id = m->id;
-            snprintf(n->name, sizeof n->name, "%s", m->name);
+            copy_str(n->name, sizeof n->name, m->name);
             n->timeout_ns = m->cycle_ms ? ms_ns(m->cycle_ms) * 3 : ms_ns(default_timeout);
             n->value_channel[0] = n->value_channel[1] = -1;
             d->dbc_node[i] = d->node_count;

@@ -41,11 +41,11 @@ int pb_candump_parse_line(const char *line, size_t len, pb_can_frame *f, char *i
     uint64_t sec = 0;
     int digits = 0;
     while (p < end && *p >= '0' && *p <= '9') {
-        if (sec > (UINT64_MAX / 1000000000u - 9) / 10) {
+        sec = sec * 10 + (uint64_t)(*p++ - '0');
+        if (sec > (uint64_t)(INT64_MAX / 1000000000 - 1)) { /* t_ns must fit int64_t */
             *why = "time stamp too large";
             return -1;
         }
-        sec = sec * 10 + (uint64_t)(*p++ - '0');
         digits++;
     }
     if (!digits || p >= end || *p++ != '.') {
@@ -75,8 +75,13 @@ int pb_candump_parse_line(const char *line, size_t len, pb_can_frame *f, char *i
     while (p < end && is_space(*p))
         p++;
     const char *ifs = p;
-    while (p < end && !is_space(*p))
+    while (p < end && !is_space(*p)) {
+        if (*p < '!' || *p > '~') { /* interface names are printable: the writer must give them back */
+            *why = "interface name with a control or non-ASCII character";
+            return -1;
+        }
         p++;
+    }
     if (p == ifs || p >= end) {
         *why = "expected an interface name and a frame";
         return -1;

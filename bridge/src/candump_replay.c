@@ -89,7 +89,10 @@ static int replay_read(pb_source *src, pb_update *out, int timeout_ms)
             }
             const int64_t due = s->start_mono + (int64_t)((double)(s->pending.t_ns - s->start_rel) / speed);
             const int64_t now = pb_can_mono_ns();
-            if (due > now) {
+            /* Frames due within 100 us go now: a sleep that short wakes later
+             * than that (timer slack), and bursts of frames microseconds
+             * apart would pile up the error. */
+            if (due - now > 100000) {
                 if (deadline <= now)
                     return 0;
                 sleep_ns((due < deadline ? due : deadline) - now);
