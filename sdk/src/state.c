@@ -224,6 +224,12 @@ pose_status pose_apply(pose_state *st)
     return POSE_OK;
 }
 
+size_t pose__state_frame_bytes(const pose_state *st)
+{
+    return pose__skin_bytes((int)st->method, &st->rt->skin) +
+           pose__transfer_bytes(&st->rt->transfer, st->rig->tet_vertex_count, 1);
+}
+
 const float *pose_tissue_positions(const pose_state *st, int tissue, size_t *vertex_count)
 {
     if (!st || tissue < 0 || (size_t)tissue >= st->rig->tissue_count)

@@ -34,6 +34,10 @@ struct pose_state {
     void *block;                /**< the allocation holding everything else */
 };
 
+/** Bytes pose_apply must move per frame with the state's method: every
+ *  array the kernels stream, read or written once (benchmarks). */
+size_t pose__state_frame_bytes(const pose_state *st);
+
 /** Joint rotation setters' shared tail: clamp q to joint j's limits, store it. */
 pose_status pose__state_store_joint(pose_state *st, int joint, float q[4]);
 
