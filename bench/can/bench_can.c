@@ -28,6 +28,12 @@ static double now_s(void)
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
 static const char *const BODY[][2] = {
     {"pelvis", ""}, {"lumbar", "pelvis"}, {"thorax", "lumbar"}, {"neck", "thorax"}, {"head", "neck"},
     {"clavicle_r", "thorax"}, {"shoulder_r", "clavicle_r"}, {"elbow_r", "shoulder_r"}, {"wrist_r", "elbow_r"},
@@ -240,6 +246,8 @@ int main(int argc, char **argv)
             die("mapping", &err);
         size_t updates = 0;
         double late_max = 0, late_sum = 0;
+        static double lates[1 << 16];
+        size_t nlate = 0;
         const double start = now_s();
         const double limit = pass == 0 ? 1e9 : 2.0; /* recorded timing: two seconds of it */
         int rc;
@@ -252,6 +260,8 @@ int main(int argc, char **argv)
                 const double late = (now_s() - start) - u.t_ns * 1e-9;
                 late_sum += late;
                 late_max = late > late_max ? late : late_max;
+                if (nlate < sizeof lates / sizeof lates[0])
+                    lates[nlate++] = late;
                 if (u.t_ns * 1e-9 >= limit)
                     break;
             }
@@ -268,9 +278,21 @@ int main(int argc, char **argv)
                    (unsigned long long)st->short_frames,
                    updates == expected && st->frames == written && !st->dropped ? "nothing dropped" : "LOST FRAMES");
         } else {
-            printf("recorded-timing replay: %zu updates over %.2f s, lateness mean %.1f us, max %.1f us "
-                   "(target < 1 ms)\n",
-                   updates, wall, late_sum / (double)(updates ? updates : 1) * 1e6, late_max * 1e6);
+            qsort(lates, nlate, sizeof lates[0], cmp_double);
+            /* what this machine's scheduler allows: how late a 200 us sleep wakes */
+            double sleep_late[200];
+            for (int i = 0; i < 200; i++) {
+                const double a = now_s();
+                const struct timespec ts = {0, 200000};
+                nanosleep(&ts, NULL);
+                sleep_late[i] = now_s() - a - 200e-6;
+            }
+            qsort(sleep_late, 200, sizeof sleep_late[0], cmp_double);
+            printf("recorded-timing replay: %zu updates over %.2f s, lateness mean %.1f us, median %.1f us, "
+                   "p99 %.1f us, max %.1f us (target < 1 ms); a 200 us nanosleep here wakes late by "
+                   "median %.1f us, max %.1f us\n",
+                   updates, wall, late_sum / (double)(updates ? updates : 1) * 1e6, lates[nlate / 2] * 1e6,
+                   lates[nlate * 99 / 100] * 1e6, late_max * 1e6, sleep_late[100] * 1e6, sleep_late[199] * 1e6);
         }
         pb_chanmap_free(cm);
         pb_source_destroy(src);

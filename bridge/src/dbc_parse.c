@@ -774,8 +774,11 @@ static void parse_all(parser *ps)
         if (tok_is(&t, "VERSION")) {
             expect_kind(ps, T_STRING, "a version string");
         } else if (tok_is(&t, "NS_")) {
+            /* The list names statement keywords, indented or not; BS_, BU_ or
+             * BO_ (never in it) end it. */
             expect_punct(ps, ':');
-            while (peek(ps)->kind == T_IDENT && (peek(ps)->line == t.line || peek(ps)->col > 0))
+            while (peek(ps)->kind == T_IDENT && !tok_is(peek(ps), "BS_") && !tok_is(peek(ps), "BU_") &&
+                   !tok_is(peek(ps), "BO_"))
                 next(ps);
         } else if (tok_is(&t, "BS_") || tok_is(&t, "BU_")) {
             expect_punct(ps, ':');
@@ -823,6 +826,10 @@ int pb_dbc_parse(const char *text, size_t len, const char *name, pb_dbc **out, p
         return -1;
     }
     d->path = path;
+    if (len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0) { /* UTF-8 byte order mark */
+        text += 3;
+        len -= 3;
+    }
     ps->p = ps->start = ps->line_start = text;
     ps->end = text + len;
     ps->name = d->path;

@@ -122,8 +122,9 @@ static int run(int argc, char **argv)
     int rc;
     while ((rc = pb_candump_next(&r, &f)) == 1) {
         if (r.bad_lines != bad_seen) {
+            fprintf(stderr, "pose-bridge can-decode: skipped %zu malformed line(s), the last %s\n",
+                    r.bad_lines - bad_seen, r.last_error);
             bad_seen = r.bad_lines;
-            fprintf(stderr, "pose-bridge can-decode: skipped %s\n", r.last_error);
         }
         if (dec) {
             pb_update u;
@@ -185,7 +186,8 @@ static int run(int argc, char **argv)
         decoded++;
     }
     if (r.bad_lines != bad_seen)
-        fprintf(stderr, "pose-bridge can-decode: skipped %s\n", r.last_error);
+        fprintf(stderr, "pose-bridge can-decode: skipped %zu malformed line(s), the last %s\n",
+                r.bad_lines - bad_seen, r.last_error);
     fprintf(stderr, "pose-bridge can-decode: %zu frames, %zu decoded, %zu with a length other than the DBC's, "
                     "%zu malformed lines\n",
             r.frames, decoded, length_mismatch, r.bad_lines);

@@ -71,7 +71,14 @@ static void test_malformed(void **state)
     assert_int_equal(d->message_count, 1);
     assert_int_equal(d->messages[0].id, 5);
     pb_dbc_free(d);
-    /* A VAL_ for a signal that does not exist is a warning, not an error. */
+    /* A byte order mark, CRLF line ends and an unindented NS_ list are fine. */
+    d = parse_ok("\xEF\xBB\xBFVERSION \"\"\r\nNS_ :\r\nSIG_VALTYPE_\r\nVAL_\r\nBA_\r\n\r\nBS_:\r\n"
+                 "BU_: N\r\nBO_ 5 M: 1 N\r\n SG_ a : 0|8@1+ (1,0) [0|0] \"\" N\r\n");
+    assert_int_equal(d->message_count, 1);
+    assert_int_equal(d->messages[0].signal_count, 1);
+    assert_int_equal(d->messages[0].signals[0].line, 10);
+    pb_dbc_free(d);
+        /* A VAL_ for a signal that does not exist is a warning, not an error. */
     d = parse_ok("BO_ 5 M: 1 N\nVAL_ 5 nope 1 \"one\" ;\n");
     assert_int_equal(d->warning_count, 1);
     assert_non_null(strstr(d->warning, "inline.dbc:2:"));
