@@ -47,6 +47,12 @@ typedef enum pose_synth_cor_mode {
     POSE_SYNTH_COR_NONE = 3,
 } pose_synth_cor_mode;
 
+/**
+ * Progress report: `stage` is "mesh" or "cor", `fraction` in [0, 1]. Called
+ * from the generating thread, a few hundred times at most.
+ */
+typedef void (*pose_synth_progress_fn)(const char *stage, double fraction, void *user);
+
 /** Options for pose_synth_bar; a zeroed struct gives the defaults. */
 typedef struct pose_synth_bar_options {
     int bones;                /**< number of bones, 1..64; 0 = 4 */
@@ -61,6 +67,8 @@ typedef struct pose_synth_bar_options {
     unsigned influences;      /**< K weights per vertex, 1..8; 0 = 4 */
     float sigma;              /**< CoR similarity width, (0, 0.1]; 0 = 0.1 */
     pose_synth_cor_mode cor;  /**< AUTO = exact */
+    pose_synth_progress_fn progress; /**< optional */
+    void *progress_user;
 } pose_synth_bar_options;
 
 /** Options for pose_synth_body; a zeroed struct gives the defaults. */
@@ -70,6 +78,8 @@ typedef struct pose_synth_body_options {
     unsigned influences;      /**< 0 = 4 */
     float sigma;              /**< 0 = 0.1 */
     pose_synth_cor_mode cor;  /**< AUTO = clustered */
+    pose_synth_progress_fn progress; /**< optional */
+    void *progress_user;
 } pose_synth_body_options;
 
 typedef struct pose_synth_rig pose_synth_rig;

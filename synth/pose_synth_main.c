@@ -54,6 +54,26 @@ static double now(void)
     return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
+/* Progress on a terminal: "stage NN% (ETA s)", one line per stage. */
+typedef struct progress_state {
+    const char *stage;
+    double start;
+} progress_state;
+
+static void on_progress(const char *stage, double fraction, void *user)
+{
+    progress_state *p = user;
+    double t = now();
+    if (!p->stage || strcmp(p->stage, stage) != 0) {
+        p->stage = stage;
+        p->start = t;
+    }
+    double eta = fraction > 0.0 ? (t - p->start) * (1.0 - fraction) / fraction : 0.0;
+    fprintf(stderr, "\rpose-synth: %-5s %3.0f%% (ETA %.0f s)   ", stage, 100.0 * fraction, eta);
+    if (fraction >= 1.0)
+        fputc('\n', stderr);
+}
+
 static const char *cor_name(pose_synth_cor_mode m)
 {
     switch (m) {
@@ -118,17 +138,20 @@ int main(int argc, char **argv)
     }
     int progress = isatty(STDERR_FILENO);
     if (progress)
-        fprintf(stderr, "pose-synth: [1/2] generating %s rig...\n", kind);
+        fprintf(stderr, "pose-synth: generating %s rig\n", kind);
     double t0 = now();
     pose_synth_rig *rig = NULL;
     pose_status st;
+    progress_state prog = {NULL, 0.0};
+    pose_synth_progress_fn report = progress ? on_progress : NULL;
     if (!strcmp(kind, "bar")) {
-        pose_synth_bar_options o = {.bones = bones, .cor = cor};
+        pose_synth_bar_options o = {.bones = bones, .cor = cor, .progress = report,
+                                    .progress_user = &prog};
         st = pose_synth_bar(&o, &rig);
     } else if (!strcmp(kind, "medium") && cor == POSE_SYNTH_COR_AUTO) {
         st = pose_synth_medium(&rig);
     } else if (!strcmp(kind, "medium") || !strcmp(kind, "body")) {
-        pose_synth_body_options o = {.cor = cor};
+        pose_synth_body_options o = {.cor = cor, .progress = report, .progress_user = &prog};
         o.target_tets = !strcmp(kind, "medium") ? 50000 : (size_t)tets;
         if (!strcmp(kind, "medium"))
             o.target_tissue_vertices = 18500;
@@ -143,7 +166,7 @@ int main(int argc, char **argv)
     }
     double t1 = now();
     if (progress)
-        fprintf(stderr, "pose-synth: [2/2] writing %s...\n", path);
+        fprintf(stderr, "pose-synth: writing %s\n", path);
     const pose_rig_desc *d = pose_synth_desc(rig);
     st = pose_rig_write_file(d, path);
     if (st != POSE_OK) {

@@ -211,6 +211,12 @@ static size_t cluster(blend *b, size_t n)
 pose_status pose_synth_compute_cor(const pose_rig_desc *d, float sigma, pose_synth_cor_mode mode,
                                    float *cor)
 {
+    return ps_compute_cor(d, sigma, mode, cor, NULL);
+}
+
+pose_status ps_compute_cor(const pose_rig_desc *d, float sigma, pose_synth_cor_mode mode,
+                           float *cor, const pose_synth_rig *r)
+{
     if (!d || !cor || !(sigma > 0.0f) || d->influences == 0 ||
         d->influences > POSE_SYNTH_MAX_K ||
         (mode != POSE_SYNTH_COR_EXACT && mode != POSE_SYNTH_COR_CLUSTERED))
@@ -228,6 +234,8 @@ pose_status pose_synth_compute_cor(const pose_rig_desc *d, float sigma, pose_syn
     }
     double inv_sigma2 = 1.0 / ((double)sigma * sigma);
     for (size_t v = 0; v < d->tet_vertex_count; v++) {
+        if (v % 8192 == 0)
+            ps_progress(r, "cor", (double)v / d->tet_vertex_count);
         sparse p;
         vertex_sparse(d, v, &p);
         memcpy(&cor[3 * v], &d->tet_positions[3 * v], 3 * sizeof(float));
@@ -247,5 +255,6 @@ pose_status pose_synth_compute_cor(const pose_rig_desc *d, float sigma, pose_syn
                 cor[3 * v + a] = (float)(num[a] / den);
     }
     free(b);
+    ps_progress(r, "cor", 1.0);
     return POSE_OK;
 }

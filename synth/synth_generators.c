@@ -47,6 +47,8 @@ pose_status pose_synth_bar(const pose_synth_bar_options *options, pose_synth_rig
     pose_synth_rig *r = ps_rig_new(o.influences);
     if (!r)
         return POSE_ERR_OUT_OF_MEMORY;
+    r->progress = o.progress;
+    r->progress_user = o.progress_user;
     ps_bar_spec s = {
         .prefix = "", .origin = {0, 0, 0}, .frame = {0, 0, 0, 1}, .bones = o.bones,
         .period = o.bone_length, .radius = o.radius, .rings = o.rings, .sectors = o.sectors,
@@ -58,6 +60,7 @@ pose_status pose_synth_bar(const pose_synth_bar_options *options, pose_synth_rig
         pose_synth_free(r);
         return POSE_ERR_OUT_OF_MEMORY;
     }
+    ps_progress(r, "mesh", 1.0);
     return finish_or_free(r, o.cor, o.sigma, "bar", out);
 }
 
@@ -92,6 +95,7 @@ static int round8(double x)
 
 static pose_status make_body(size_t target_tets, size_t target_tissue, unsigned influences,
                              float sigma, pose_synth_cor_mode cor, const char *name,
+                             pose_synth_progress_fn progress, void *progress_user,
                              pose_synth_rig **out)
 {
     double length = 0.0;
@@ -107,6 +111,8 @@ static pose_status make_body(size_t target_tets, size_t target_tissue, unsigned 
     pose_synth_rig *r = ps_rig_new(influences);
     if (!r)
         return POSE_ERR_OUT_OF_MEMORY;
+    r->progress = progress;
+    r->progress_user = progress_user;
     size_t first_joint[BODY_BARS];
     bool ok = ps_reserve(r, (size_t)(target_tets / 4.2), target_tets + target_tets / 8);
     for (size_t i = 0; ok && i < BODY_BARS; i++) {
@@ -128,6 +134,7 @@ static pose_status make_body(size_t target_tets, size_t target_tissue, unsigned 
         ps_quat_from_to(x, bb->dir, s.frame);
         first_joint[i] = r->joint_count;
         ok = ps_add_bar(r, &s);
+        ps_progress(r, "mesh", (double)(i + 1) / BODY_BARS);
     }
     if (!ok) {
         pose_synth_free(r);
@@ -152,7 +159,7 @@ pose_status pose_synth_body(const pose_synth_body_options *options, pose_synth_r
         o.cor > POSE_SYNTH_COR_NONE)
         return POSE_ERR_INVALID_ARGUMENT;
     return make_body(o.target_tets, o.target_tissue_vertices, o.influences, o.sigma, o.cor,
-                     "body", out);
+                     "body", o.progress, o.progress_user, out);
 }
 
 pose_status pose_synth_medium(pose_synth_rig **out)
@@ -160,5 +167,5 @@ pose_status pose_synth_medium(pose_synth_rig **out)
     if (!out)
         return POSE_ERR_INVALID_ARGUMENT;
     *out = NULL;
-    return make_body(50000, 18500, 4, 0.1f, POSE_SYNTH_COR_EXACT, "medium", out);
+    return make_body(50000, 18500, 4, 0.1f, POSE_SYNTH_COR_EXACT, "medium", NULL, NULL, out);
 }

@@ -45,6 +45,8 @@ struct pose_synth_rig {
     size_t tissue_count, tissue_cap;
     char *metadata;
     pose_rig_desc desc;
+    pose_synth_progress_fn progress;
+    void *progress_user;
 };
 
 /** A bar of bones along the local +X axis, placed by origin + rotation. */
@@ -73,6 +75,12 @@ bool ps_add_bar(pose_synth_rig *r, const ps_bar_spec *s);
 /** Compute CoR (mode != NONE), set metadata, fill r->desc. */
 pose_status ps_finish(pose_synth_rig *r, pose_synth_cor_mode mode, float sigma,
                       const char *generator);
+
+/** Report progress if a callback was given. */
+void ps_progress(const pose_synth_rig *r, const char *stage, double fraction);
+/** pose_synth_compute_cor with progress reports through r (may be NULL). */
+pose_status ps_compute_cor(const pose_rig_desc *d, float sigma, pose_synth_cor_mode mode,
+                           float *cor, const pose_synth_rig *r);
 
 /* Quaternion helpers (x, y, z, w). */
 void ps_quat_rotate(const float q[4], const float v[3], float out[3]);

@@ -95,6 +95,12 @@ pose_synth_cor_mode pose_synth_cor(const pose_synth_rig *r)
     return r ? r->cor_mode : POSE_SYNTH_COR_NONE;
 }
 
+void ps_progress(const pose_synth_rig *r, const char *stage, double fraction)
+{
+    if (r && r->progress)
+        r->progress(stage, fraction, r->progress_user);
+}
+
 void ps_quat_rotate(const float q[4], const float v[3], float out[3])
 {
     float tx = 2.0f * (q[1] * v[2] - q[2] * v[1]);
@@ -165,7 +171,7 @@ pose_status ps_finish(pose_synth_rig *r, pose_synth_cor_mode mode, float sigma,
         r->cor = malloc(r->vertex_count * 3 * sizeof(float));
         if (!r->cor)
             return POSE_ERR_OUT_OF_MEMORY;
-        pose_status st = pose_synth_compute_cor(d, sigma, mode, r->cor);
+        pose_status st = ps_compute_cor(d, sigma, mode, r->cor, r);
         if (st != POSE_OK)
             return st;
         d->cor = r->cor;
