@@ -115,8 +115,10 @@ have_source=0
 if [ $have_bake -eq 1 ]; then
     stage "3/5 bake the bundled anatomy (reduced resolution)"
     rig="$out/body.rig"
-    "$bake" --template "$root/preprocess/templates/full_body.json" --anatomy "$root/data/anatomy" \
-        --resolution demo -o "$rig" 2>&1 | tee -a "$log" || die "pose-bake failed; see $log"
+    # 20 mm voxels: ~12 k tet vertices, ~50 k tets (the default resolution is finer and slower).
+    "$bake" --skin "$root/data/anatomy/skin.obj" --bones "$root/data/anatomy/bones" \
+        --template "$root/preprocess/templates/full_body.json" --resolution 20 -o "$rig" | tee -a "$log"
+    [ "${PIPESTATUS[0]}" -eq 0 ] || die "pose-bake failed; see $log"
     map="$root/bridge/maps/cmu131_bvh_to_full_body.json"
     kind=body
 else
@@ -129,7 +131,18 @@ else
     kind=bar
 fi
 joints=$("$render" "$rig" --list-joints | awk '{print $1}')
-joint=$(grep -x -m1 -e knee_r -e joint2 <<<"$joints" || sed -n 3p <<<"$joints")
+# The joints the comparison panels use: the body's right knee and forearm, or the bar's joint 2.
+if grep -qx knee_r <<<"$joints" && grep -qx elbow_r <<<"$joints"; then
+    joint=knee_r
+    bend=(--pose knee_r=0,130,0 --pose hip_r=0,-70,0 --focus knee_r --caption "knee bend 130 deg")
+    twist=(--pose elbow_r=0,0,80 --pose wrist_r=0,0,80 --focus elbow_r --caption "forearm twist 160 deg")
+    panel=(--size 420x480)
+else
+    joint=$(grep -x -m1 joint2 <<<"$joints" || sed -n 3p <<<"$joints")
+    bend=(--pose "$joint=0,90,0" --caption "bend 90 deg at $joint")
+    twist=(--pose "$joint=135,0,0" --skin opaque --azimuth 90 --elevation 10 --caption "twist 135 deg at $joint")
+    panel=(--size 480x300)
+fi
 
 if [ $have_source -eq 1 ] && [ -n "$map" ] && [ -f "$map" ]; then
     stage "4/5 replay $(basename "$clip") (CMU walk) onto the $kind through the bridge, mapping $(basename "$map")"
@@ -144,10 +157,10 @@ if [ $have_source -eq 1 ] && [ -n "$map" ] && [ -f "$map" ]; then
         echo " and applied by the bridge library linked into pose-render)"
     fi
     stage "5/5 render frames (OSMesa, off-screen)"
-    "$render" "$rig" --source "$clip" --map "$map" --frames 1-961:60 --caption "CMU 131_01 walk" \
-        -o "$frames_dir" | tee -a "$log"
+    "$render" "$rig" --source "$clip" --map "$map" --frames 1-961:60 --fit follow --caption "CMU 131_01 walk" \
+        "${panel[@]}" -o "$frames_dir" | tee -a "$log"
     "$render" "$rig" --compare --source "$clip" --map "$map" --frames 481 --caption "walk frame 481" \
-        -o "$out/compare_walk.png" | tee -a "$log"
+        "${panel[@]}" -o "$out/compare_walk.png" | tee -a "$log"
 else
     stage "4/5 replay: this build has no bridge - posing joint $joint by hand instead"
     stage "5/5 render frames (OSMesa, off-screen)"
@@ -157,10 +170,8 @@ else
     done
 fi
 # The paper's comparisons (Fig. 7-8) on the same rig, and the weights of one joint (Fig. 5).
-"$render" "$rig" --compare --pose "$joint=0,90,0" --caption "bend 90 deg at $joint" \
-    -o "$out/compare_bend.png" | tee -a "$log"
-"$render" "$rig" --compare --pose "$joint=135,0,0" --caption "twist 135 deg at $joint" \
-    -o "$out/compare_twist.png" | tee -a "$log"
+"$render" "$rig" --compare "${bend[@]}" "${panel[@]}" -o "$out/compare_bend.png" | tee -a "$log"
+"$render" "$rig" --compare "${twist[@]}" "${panel[@]}" -o "$out/compare_twist.png" | tee -a "$log"
 "$render" "$rig" --weights "$joint" --caption "weight of $joint" -o "$out/weights.png" | tee -a "$log"
 if [ -n "$export_tool" ]; then
     "$export_tool" "$rig" --pose "$joint=0,90,0" --obj "$out/posed.obj" --vtu "$out/posed.vtu" \

@@ -68,11 +68,11 @@ static void ex_draw_weights(ex_scene *sc)
     glEnd();
 }
 
-void ex_draw_scene(ex_scene *sc, const ex_camera *cam, int width, int height, const float bg[3])
+void ex_draw_scene(ex_scene *sc, const ex_camera *cam, int x, int y, int width, int height, const float bg[3])
 {
     float view[16], proj[16];
     float aspect = height > 0 ? (float)width / (float)height : 1.0f;
-    glViewport(0, 0, width, height);
+    glViewport(x, y, width, height);
     glClearColor(bg[0], bg[1], bg[2], 1.0f);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glEnable(GL_DEPTH_TEST);

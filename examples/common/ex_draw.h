@@ -11,11 +11,13 @@
 #include "ex_scene.h"
 
 /**
- * Clear to the background and draw the scene's visible tissues (opaque ones
- * first, then the skin, translucent when the scene says so), or the tet
- * boundary coloured by a joint's weight when sc->weight_joint >= 0.
+ * Clear the framebuffer to the background and draw the scene's visible
+ * tissues (opaque ones first, then the skin, translucent when the scene says
+ * so), or the tet boundary coloured by a joint's weight when
+ * sc->weight_joint >= 0, into the viewport (x, y, width, height) in GL
+ * pixels (origin bottom left).
  */
-void ex_draw_scene(ex_scene *sc, const ex_camera *cam, int width, int height, const float bg[3]);
+void ex_draw_scene(ex_scene *sc, const ex_camera *cam, int x, int y, int width, int height, const float bg[3]);
 
 /** Joint centres as points (the selected one larger and yellow), over everything. */
 void ex_draw_joints(const ex_scene *sc, int selected);

@@ -5,6 +5,7 @@
  * source, a turntable, or an LBS | DQS | CoR panel of the same pose.
  */
 #include <GL/osmesa.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -22,11 +23,12 @@
 enum { MAX_POSES = 64, PANELS_MAX = 3 };
 
 typedef struct options {
-    const char *rig, *output, *source, *map, *caption, *weights;
+    const char *rig, *output, *source, *map, *caption, *weights, *focus;
     const char *poses[MAX_POSES];
     int pose_count;
     int width, height, supersample, turntable, compare, json, threads, list_joints;
     int fit_rest; /* frame the camera on the rest pose only (comparable images across calls) */
+    int follow;   /* --frames: the camera follows the model (moving target, fixed distance) */
     int method; /* -1: CoR when the rig has it, else LBS */
     long *frames;
     size_t frame_count;
@@ -66,8 +68,10 @@ static void usage(FILE *f)
           "  --weights JOINT              colour the tet mesh by this joint's skinning weight\n"
           "  --caption TEXT               caption drawn at the top of each image\n"
           "  --azimuth DEG --elevation DEG --zoom F   camera (default: frames the whole model)\n"
-          "  --fit pose|rest              frame the rest pose and every pose shown (default), or the\n"
-          "                               rest pose only, so separate runs share one camera\n"
+          "  --focus JOINT                close-up: frame the region around this joint\n"
+          "  --fit pose|rest|follow       frame every pose shown (default); or the rest pose only, so\n"
+          "                               separate runs share one camera; or, with --frames, follow\n"
+          "                               the model from frame to frame at a fixed distance\n"
           "  --size WxH                   image size (default 640x640; a panel is 3 of these)\n"
           "  --supersample N              anti-aliasing factor 1..4 (default 2)\n"
           "  --threads N                  pose_apply worker threads (default: cores)\n"
@@ -81,6 +85,28 @@ static void usage(FILE *f)
     fputs(ex_motion_available() ? "Sources: through the input bridge (BVH, ASF/AMC, HID and CAN recordings).\n"
                                 : "Sources: none, built without the bridge (--source is refused).\n",
           f);
+}
+
+/* Text scales: captions on top, method labels under the panels of --compare. */
+static int caption_scale(int image_width)
+{
+    return image_width >= 480 ? 2 : 1;
+}
+
+static int label_scale(int width)
+{
+    return width >= 480 ? 3 : 2;
+}
+
+/* Bands kept free of the model, so text never covers it. */
+static int caption_band(const options *o)
+{
+    return o->caption || o->source ? EX_FONT_H * caption_scale(o->width * (o->compare ? 3 : 1)) + 12 : 0;
+}
+
+static int label_band(const options *o)
+{
+    return o->compare ? EX_FONT_H * label_scale(o->width) + 10 : 0;
 }
 
 static int parse_kinds(const char *s, unsigned *mask, char *err, size_t err_size)
@@ -147,6 +173,8 @@ static int parse_args(int argc, char **argv, options *o, char *err, size_t err_s
             o->caption = v;
         } else if (!strcmp(a, "--weights")) {
             o->weights = v;
+        } else if (!strcmp(a, "--focus")) {
+            o->focus = v;
         } else if (!strcmp(a, "--pose")) {
             if (o->pose_count == MAX_POSES) {
                 snprintf(err, err_size, "--pose: at most %d joints", MAX_POSES);
@@ -178,11 +206,12 @@ static int parse_args(int argc, char **argv, options *o, char *err, size_t err_s
             }
             o->skin = (ex_skin_mode)m;
         } else if (!strcmp(a, "--fit")) {
-            if (strcmp(v, "pose") && strcmp(v, "rest")) {
-                snprintf(err, err_size, "--fit: expected pose or rest, got '%s'", v);
+            if (strcmp(v, "pose") && strcmp(v, "rest") && strcmp(v, "follow")) {
+                snprintf(err, err_size, "--fit: expected pose, rest or follow, got '%s'", v);
                 return -1;
             }
             o->fit_rest = !strcmp(v, "rest");
+            o->follow = !strcmp(v, "follow");
         } else if (!strcmp(a, "--hide")) {
             if (parse_kinds(v, &o->hide, err, err_size) < 0)
                 return -1;
@@ -232,6 +261,11 @@ static int parse_args(int argc, char **argv, options *o, char *err, size_t err_s
         snprintf(err, err_size, "--source needs --frames (e.g. --frames 0,30,60)");
         return -1;
     }
+    if (o->height - caption_band(o) - label_band(o) < 16) {
+        snprintf(err, err_size, "--size: %dx%d leaves no room for the picture under the caption and labels",
+                 o->width, o->height);
+        return -1;
+    }
     if ((long)o->width * o->height * o->supersample * o->supersample * (o->compare ? 3 : 1) > 64L << 20) {
         snprintf(err, err_size, "image too large: reduce --size or --supersample");
         return -1;
@@ -264,10 +298,11 @@ static void renderer_free(renderer *r)
     free(r->fb);
 }
 
-/* Draw the scene and read it back into img (w x h, top row first, opaque). */
-static void render_to(renderer *r, ex_scene *sc, const ex_camera *cam, ex_image *img)
+/* Draw the scene between the bands and read it back into img (w x h, top row first, opaque). */
+static void render_to(renderer *r, const options *o, ex_scene *sc, const ex_camera *cam, ex_image *img)
 {
-    ex_draw_scene(sc, cam, r->w * r->ss, r->h * r->ss, bg);
+    int top = caption_band(o), bottom = label_band(o);
+    ex_draw_scene(sc, cam, 0, bottom * r->ss, r->w * r->ss, (r->h - top - bottom) * r->ss, bg);
     glFinish();
     ex_image_downsample_flip(img, r->fb, r->ss);
     for (size_t i = 0; i < (size_t)img->width * (size_t)img->height; i++)
@@ -290,9 +325,9 @@ static void caption(ex_image *img, const char *text)
 {
     if (!text || !*text)
         return;
-    int scale = img->width >= 480 ? 2 : 1;
+    int scale = caption_scale(img->width);
     int x = (img->width - ex_font_text_width(text) * scale) / 2;
-    ex_image_text(img, x > 4 ? x : 4, 6 * scale, scale, text_col, text);
+    ex_image_text(img, x > 4 ? x : 4, 6, scale, text_col, text);
 }
 
 typedef struct summary {
@@ -334,15 +369,23 @@ static int make_dir(const char *dir, char *err, size_t err_size)
     return -1;
 }
 
-/* Camera for bounds bmin/bmax in an image of aspect w/h, with the user's direction and zoom. */
-static void setup_camera(ex_camera *cam, const options *o, const float bmin[3], const float bmax[3])
+/*
+ * Camera looking at bounds bmin/bmax in an image of aspect w/h, from the
+ * user's direction or the default one, then fitted to the focus box when
+ * there is one (the direction still chosen from the whole model).
+ */
+static void setup_camera(ex_camera *cam, const options *o, const float bmin[3], const float bmax[3],
+                         const float *fmin, const float *fmax, float aspect)
 {
-    ex_camera_frame(cam, bmin, bmax, (float)o->width / (float)o->height);
+    ex_camera_frame(cam, bmin, bmax, aspect);
     if (o->have_azimuth)
         cam->azimuth_deg = (float)o->azimuth;
     if (o->have_elevation)
         cam->elevation_deg = (float)o->elevation;
-    ex_camera_fit(cam, bmin, bmax, (float)o->width / (float)o->height);
+    if (fmin)
+        for (int i = 0; i < 3; i++)
+            cam->target[i] = 0.5f * (fmin[i] + fmax[i]);
+    ex_camera_fit(cam, fmin ? fmin : bmin, fmin ? fmax : bmax, aspect);
     cam->distance /= (float)o->zoom;
 }
 
@@ -426,6 +469,7 @@ static int run(const options *o, summary *s, char *err, size_t err_size)
     float bmin[3], bmax[3];
     if (ex_scene_apply(&sc, err, err_size) < 0)
         goto done;
+    float half[3] = {0.0f, 0.0f, 0.0f}; /* largest half-extents of one frame, for --fit follow */
     ex_scene_bounds(&sc, !o->fit_rest, bmin, bmax);
     if (motion && !o->fit_rest)
         for (size_t i = 0; i < o->frame_count; i++) {
@@ -436,13 +480,35 @@ static int run(const options *o, summary *s, char *err, size_t err_size)
                 ex_scene_bounds(&sc, 1, bmin, bmax);
             else
                 grow_bounds(&sc, bmin, bmax);
+            float a[3], b[3];
+            ex_scene_bounds(&sc, 1, a, b);
+            for (int k = 0; k < 3; k++)
+                half[k] = fmaxf(half[k], 0.5f * (b[k] - a[k]));
         }
     if (o->compare && !o->fit_rest)
         for (int m = 0; m < 3; m++)
             if (pose_set_method(sc.state, (pose_method)m) == POSE_OK && ex_scene_apply(&sc, err, err_size) == 0)
                 grow_bounds(&sc, bmin, bmax);
+    float fmin[3], fmax[3];
+    if (o->focus) {
+        /* A box around the joint, a fifth of the model's size on each side. */
+        int j = pose_rig_find_joint(sc.rig, o->focus);
+        pose_transform x;
+        if (j < 0 || pose_joint_world(sc.state, j, &x) < 0) {
+            snprintf(err, err_size, "--focus: the rig has no joint '%s'", o->focus);
+            goto done;
+        }
+        float d = 0.0f;
+        for (int i = 0; i < 3; i++)
+            d = fmaxf(d, bmax[i] - bmin[i]);
+        for (int i = 0; i < 3; i++) {
+            fmin[i] = x.translation[i] - 0.2f * d;
+            fmax[i] = x.translation[i] + 0.2f * d;
+        }
+    }
     ex_camera cam;
-    setup_camera(&cam, o, bmin, bmax);
+    setup_camera(&cam, o, bmin, bmax, o->focus ? fmin : NULL, o->focus ? fmax : NULL,
+                 (float)o->width / (float)(o->height - caption_band(o) - label_band(o)));
 
     if (renderer_init(&r, o->width, o->height, o->supersample, err, err_size) < 0 ||
         ex_image_init(&img, o->width, o->height, bg8) < 0) {
@@ -474,12 +540,12 @@ static int run(const options *o, summary *s, char *err, size_t err_size)
                 if (ex_scene_apply(&sc, err, err_size) < 0)
                     goto done;
                 apply += sc.last_apply_ms;
-                render_to(&r, &sc, &cam, &img);
+                render_to(&r, o, &sc, &cam, &img);
                 snprintf(label, sizeof label, "%s", ex_method_name(methods[m]));
             }
-            int scale = o->width >= 480 ? 3 : 2;
+            int scale = label_scale(o->width);
             ex_image_text(&img, (img.width - ex_font_text_width(label) * scale) / 2,
-                          img.height - (EX_FONT_H + 4) * scale, scale, text_col, label);
+                          img.height - EX_FONT_H * scale - 5, scale, text_col, label);
             ex_image_blit(&panel, &img, m * o->width, 0);
         }
         caption(&panel, o->caption);
@@ -492,7 +558,18 @@ static int run(const options *o, summary *s, char *err, size_t err_size)
             if (ex_motion_set_frame(motion, sc.state, o->frames[i], err, err_size) < 0 ||
                 ex_scene_apply(&sc, err, err_size) < 0)
                 goto done;
-            render_to(&r, &sc, &cam, &img);
+            if (o->follow) { /* same size of box every frame: the distance stays, the target moves */
+                float a[3], b[3];
+                ex_scene_bounds(&sc, 1, a, b);
+                for (int k = 0; k < 3; k++) {
+                    float c = 0.5f * (a[k] + b[k]);
+                    a[k] = c - half[k];
+                    b[k] = c + half[k];
+                }
+                setup_camera(&cam, o, bmin, bmax, a, b,
+                             (float)o->width / (float)(o->height - caption_band(o) - label_band(o)));
+            }
+            render_to(&r, o, &sc, &cam, &img);
             snprintf(text, sizeof text, "%s%sframe %ld  %s", o->caption ? o->caption : "",
                      o->caption ? "  " : "", o->frames[i], ex_method_name(method));
             caption(&img, text);
@@ -508,7 +585,7 @@ static int run(const options *o, summary *s, char *err, size_t err_size)
         for (int i = 0; i < o->turntable; i++) {
             double t0 = ex_now();
             cam.azimuth_deg = az0 + 360.0f * (float)i / (float)o->turntable;
-            render_to(&r, &sc, &cam, &img);
+            render_to(&r, o, &sc, &cam, &img);
             caption(&img, o->caption);
             snprintf(path, sizeof path, "%s/turn_%03d.png", out, i);
             if (emit(s, &img, path, -1, ex_method_name(method), 1e3 * (ex_now() - t0), sc.last_apply_ms, err,
@@ -519,7 +596,7 @@ static int run(const options *o, summary *s, char *err, size_t err_size)
         double t0 = ex_now();
         if (ex_scene_apply(&sc, err, err_size) < 0)
             goto done;
-        render_to(&r, &sc, &cam, &img);
+        render_to(&r, o, &sc, &cam, &img);
         caption(&img, o->caption);
         if (emit(s, &img, out, -1, ex_method_name(method), 1e3 * (ex_now() - t0), sc.last_apply_ms, err,
                  err_size) < 0)

@@ -368,7 +368,7 @@ int main(int argc, char **argv)
         int fw, fh;
         glfwGetFramebufferSize(win, &fw, &fh);
         static const float bg[3] = {0.13f, 0.14f, 0.17f};
-        ex_draw_scene(&v.sc, &v.cam, fw, fh, bg);
+        ex_draw_scene(&v.sc, &v.cam, 0, 0, fw, fh, bg);
         if (v.show_joints)
             ex_draw_joints(&v.sc, v.joint);
         hud(&v, fw, fh);
