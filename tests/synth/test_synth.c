@@ -237,7 +237,7 @@ static void test_cor_exact_matches_formula(void **state)
     const size_t J = d->joint_count;
     const double sigma2 = 0.1 * 0.1;
     size_t checked = 0;
-    for (size_t p = 0; p < d->tet_vertex_count && checked < 40; p += 7) {
+    for (size_t p = 0; p < d->tet_vertex_count && checked < 12; p += 23) {
         double wp[8] = {0};
         for (unsigned k = 0; k < K; k++)
             wp[d->weight_joints[p * K + k]] += d->weights[p * K + k];
@@ -277,7 +277,7 @@ static void test_cor_exact_matches_formula(void **state)
             assert_float_equal(d->cor[3 * p + i], num[i] / den, 1e-5);
         checked++;
     }
-    assert_int_equal(checked, 40);
+    assert_int_equal(checked, 12);
     pose_synth_free(r);
 }
 
