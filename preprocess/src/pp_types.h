@@ -43,6 +43,8 @@ typedef struct pp_tet_quality {
     double total_volume;       /**< m^3, sum of signed volumes */
     size_t inverted_count;     /**< tets with volume <= 0 */
     size_t vertex_count, tet_count;
+    size_t labels_lost;        /**< bone labels of the voxel image no tet carries (a bone
+                                    smaller than a cell, sharing it with another bone) */
     double seconds;            /**< wall time of the stage that built the mesh */
 } pp_tet_quality;
 

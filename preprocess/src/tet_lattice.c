@@ -1,16 +1,19 @@
 /* SPDX-License-Identifier: Apache-2.0
  *
- * The built-in mesher: a Kuhn (Freudenthal) lattice over the labelled voxel
- * image. Each body cell is cut into six tets around its (0,0,0)-(1,1,1)
- * diagonal; every cell uses the same diagonal, so faces match between cells
- * without any search and all tets are congruent (dihedral angles 45-90
- * degrees, radius-edge 0.87). The outer boundary is then snapped onto the
- * skin (tet_snap.c). Why a lattice and not Delaunay refinement: it is
- * linear-time, needs no robust predicates, and conforms to the labels by
- * construction; its cost is a uniform size (no grading away from
- * boundaries).
+ * The built-in mesher over the labelled voxel image, in two variants:
+ *  - uniform: a Kuhn (Freudenthal) lattice. Each body cell is cut into six
+ *    tets around its (0,0,0)-(1,1,1) diagonal; every cell uses the same
+ *    diagonal, so faces match between cells without any search and all tets
+ *    are congruent (dihedral angles 45-90 degrees, radius-edge 0.87);
+ *  - graded (opt->grading > 0): a balanced octree, fine at skin and bone
+ *    boundaries and coarser inside (tet_octree.c).
+ * Then the outer boundary is snapped onto the skin (tet_snap.c). Why a
+ * lattice and not Delaunay refinement: it is linear-time, needs no robust
+ * predicates and conforms to the labels by construction.
  */
+#include "tet_cells.h"
 #include "tet_snap.h"
+#include "tet_build.h"
 #include "tetmesh.h"
 #include "voxelize.h"
 
@@ -19,94 +22,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct lattice {
-    int m[3];          /* cells per axis */
-    double c;          /* cell edge, metres */
-    double o[3];       /* corner (0,0,0) of cell (0,0,0) */
-    uint16_t *cell;    /* voxel label per cell */
-} lattice;
-
-static uint16_t voxel_at(const pp_voxels *v, int x, int y, int z)
-{
-    if (x < 0 || y < 0 || z < 0 || x >= v->nx || y >= v->ny || z >= v->nz)
-        return PP_VOXEL_OUTSIDE;
-    return v->labels[(size_t)x + (size_t)v->nx * ((size_t)y + (size_t)v->ny * z)];
-}
-
-/* Label the cells of edge c. A cell takes the voxel at its centre; a coarser
- * cell whose centre is not bone takes the most frequent bone among its voxels,
- * so a thin bone is never lost to sampling. */
-static pose_status label_cells(const pp_voxels *v, double c, lattice *L)
-{
-    double h = v->spacing;
-    size_t count = 1;
-    for (int k = 0; k < 3; k++) {
-        int n = k == 0 ? v->nx : k == 1 ? v->ny : v->nz;
-        L->o[k] = v->origin[k] - 0.5 * h;
-        L->m[k] = (int)ceil(n * h / c - 1e-9);
-        if (L->m[k] < 1)
-            L->m[k] = 1;
-        count *= (size_t)L->m[k];
-    }
-    L->c = c;
-    free(L->cell);
-    L->cell = malloc(count * sizeof *L->cell);
-    if (!L->cell)
-        return POSE_ERR_OUT_OF_MEMORY;
-    int coarse = c > 1.01 * h;
-    uint16_t seen[64];
-    int seen_n[64];
-    for (int z = 0; z < L->m[2]; z++)
-        for (int y = 0; y < L->m[1]; y++)
-            for (int x = 0; x < L->m[0]; x++) {
-                int idx[3] = {x, y, z}, lo[3], hi[3], ctr[3];
-                for (int k = 0; k < 3; k++) {
-                    double a = L->o[k] + idx[k] * c, b = a + c;
-                    /* voxel i spans origin + (i -/+ 0.5) h */
-                    ctr[k] = (int)floor((0.5 * (a + b) - v->origin[k]) / h + 0.5);
-                    lo[k] = (int)ceil((a - v->origin[k]) / h - 0.5);
-                    hi[k] = (int)floor((b - v->origin[k]) / h - 0.5);
-                }
-                uint16_t l = voxel_at(v, ctr[0], ctr[1], ctr[2]);
-                if (coarse && l < PP_VOXEL_BONE0) {
-                    int ns = 0;
-                    for (int k2 = lo[2]; k2 <= hi[2]; k2++)
-                        for (int j2 = lo[1]; j2 <= hi[1]; j2++)
-                            for (int i2 = lo[0]; i2 <= hi[0]; i2++) {
-                                uint16_t b = voxel_at(v, i2, j2, k2);
-                                if (b < PP_VOXEL_BONE0)
-                                    continue;
-                                int s = 0;
-                                while (s < ns && seen[s] != b)
-                                    s++;
-                                if (s == ns && ns < 64) {
-                                    seen[ns] = b;
-                                    seen_n[ns++] = 0;
-                                }
-                                if (s < ns)
-                                    seen_n[s]++;
-                            }
-                    int best = -1;
-                    for (int s = 0; s < ns; s++)
-                        if (best < 0 || seen_n[s] > seen_n[best])
-                            best = s;
-                    if (best >= 0)
-                        l = seen[best];
-                }
-                L->cell[(size_t)x + (size_t)L->m[0] * ((size_t)y + (size_t)L->m[1] * z)] = l;
-            }
-    return POSE_OK;
-}
-
-static uint16_t cell_at(const lattice *L, int x, int y, int z)
-{
-    if (x < 0 || y < 0 || z < 0 || x >= L->m[0] || y >= L->m[1] || z >= L->m[2])
-        return PP_VOXEL_OUTSIDE;
-    return L->cell[(size_t)x + (size_t)L->m[0] * ((size_t)y + (size_t)L->m[1] * z)];
-}
-
 /* Number the corners used by body cells into vid (UINT32_MAX when unused). */
-static size_t number_corners(const lattice *L, uint32_t *vid, size_t *cells)
+static size_t number_corners(const pp_cells *L, uint32_t *vid, size_t *cells)
 {
     size_t cx = (size_t)L->m[0] + 1, cy = (size_t)L->m[1] + 1, cz = (size_t)L->m[2] + 1;
     memset(vid, 0xff, cx * cy * cz * sizeof *vid);
@@ -114,7 +31,7 @@ static size_t number_corners(const lattice *L, uint32_t *vid, size_t *cells)
     for (int z = 0; z < L->m[2]; z++)
         for (int y = 0; y < L->m[1]; y++)
             for (int x = 0; x < L->m[0]; x++) {
-                if (cell_at(L, x, y, z) == PP_VOXEL_OUTSIDE)
+                if (pp_cells_at(L, x, y, z) == PP_VOXEL_OUTSIDE)
                     continue;
                 nc++;
                 for (int k = 0; k < 8; k++) {
@@ -140,98 +57,52 @@ static const int kuhn[6][4] = {
     {0, 6, 4, 7}, /* z y x (odd: path 0 4 6 7) */
 };
 
-pose_status pp_tet_lattice(const pp_voxels *vox, const pp_mesh *skin, const pp_tet_options *opt,
-                           pp_tetmesh *out, char *err, size_t errlen)
+/* The uniform Kuhn mesh of the body cells, with the outer faces' summed
+ * normals per vertex in *dir_out (3 per vertex). */
+pose_status pp_tet_kuhn_build(const pp_cells *L, pp_tetmesh *out, int8_t **dir_out)
 {
-    if (!vox || !out || !vox->labels)
-        return POSE_ERR_INVALID_ARGUMENT;
     memset(out, 0, sizeof *out);
-    pp_tet_options def = {0};
-    if (!opt)
-        opt = &def;
-    size_t body = 0, nvox = (size_t)vox->nx * vox->ny * vox->nz;
-    for (size_t i = 0; i < nvox; i++)
-        body += vox->labels[i] != PP_VOXEL_OUTSIDE;
-    if (body == 0) {
-        if (err && errlen)
-            snprintf(err, errlen, "tetrahedralize: the voxel image has no body voxel");
-        return POSE_ERR_INVALID_DATA;
-    }
-
-    lattice L = {0};
-    uint32_t *vid = NULL;
-    size_t nv = 0, ncell = 0;
-    double c = vox->spacing;
-    if (opt->target_vertices)
-        c = vox->spacing * cbrt((double)body / (double)opt->target_vertices);
-    /* Two tries at most: the first count corrects the estimate (the surface
-     * layer adds corners the cell count does not see). */
-    for (int pass = 0; pass < 2; pass++) {
-        pose_status s = label_cells(vox, c, &L);
-        if (s == POSE_OK) {
-            size_t corners = ((size_t)L.m[0] + 1) * ((size_t)L.m[1] + 1) * ((size_t)L.m[2] + 1);
-            free(vid);
-            vid = malloc(corners * sizeof *vid);
-            s = vid ? POSE_OK : POSE_ERR_OUT_OF_MEMORY;
-        }
-        if (s != POSE_OK) {
-            free(L.cell);
-            free(vid);
-            if (err && errlen)
-                snprintf(err, errlen, "tetrahedralize: out of memory");
-            return s;
-        }
-        nv = number_corners(&L, vid, &ncell);
-        if (!opt->target_vertices || pass == 1)
-            break;
-        double ratio = (double)nv / (double)opt->target_vertices;
-        if (ratio > 0.95 && ratio < 1.05)
-            break;
-        c *= cbrt(ratio);
-    }
+    *dir_out = NULL;
+    size_t corners = ((size_t)L->m[0] + 1) * ((size_t)L->m[1] + 1) * ((size_t)L->m[2] + 1);
+    uint32_t *vid = malloc(corners * sizeof *vid);
+    if (!vid)
+        return POSE_ERR_OUT_OF_MEMORY;
+    size_t ncell = 0;
+    size_t nv = number_corners(L, vid, &ncell);
     if (nv > UINT32_MAX || ncell * 6 > UINT32_MAX) {
-        free(L.cell);
         free(vid);
-        if (err && errlen)
-            snprintf(err, errlen, "tetrahedralize: %zu cells exceed 32-bit indices", ncell);
         return POSE_ERR_INVALID_ARGUMENT;
     }
-
     out->vertex_count = nv;
     out->tet_count = 6 * ncell;
     out->positions = malloc((nv ? nv : 1) * 3 * sizeof *out->positions);
     out->tets = malloc((ncell ? ncell : 1) * 24 * sizeof *out->tets);
     out->labels = malloc((ncell ? ncell : 1) * 6 * sizeof *out->labels);
     int8_t *dir = calloc(nv ? 3 * nv : 1, 1);
-    uint8_t *near_bone = calloc(nv ? nv : 1, 1);
-    if (!out->positions || !out->tets || !out->labels || !dir || !near_bone) {
-        free(L.cell);
+    if (!out->positions || !out->tets || !out->labels || !dir) {
         free(vid);
         free(dir);
-        free(near_bone);
         pp_tetmesh_free(out);
-        if (err && errlen)
-            snprintf(err, errlen, "tetrahedralize: out of memory");
         return POSE_ERR_OUT_OF_MEMORY;
     }
-    size_t cx = (size_t)L.m[0] + 1, cy = (size_t)L.m[1] + 1;
-    for (size_t z = 0; z <= (size_t)L.m[2]; z++)
+    size_t cx = (size_t)L->m[0] + 1, cy = (size_t)L->m[1] + 1;
+    for (size_t z = 0; z <= (size_t)L->m[2]; z++)
         for (size_t y = 0; y < cy; y++)
             for (size_t x = 0; x < cx; x++) {
                 uint32_t i = vid[x + cx * (y + cy * z)];
                 if (i == UINT32_MAX)
                     continue;
-                out->positions[3 * (size_t)i] = (float)(L.o[0] + (double)x * L.c);
-                out->positions[3 * (size_t)i + 1] = (float)(L.o[1] + (double)y * L.c);
-                out->positions[3 * (size_t)i + 2] = (float)(L.o[2] + (double)z * L.c);
+                out->positions[3 * (size_t)i] = (float)(L->o[0] + (double)x * L->c);
+                out->positions[3 * (size_t)i + 1] = (float)(L->o[1] + (double)y * L->c);
+                out->positions[3 * (size_t)i + 2] = (float)(L->o[2] + (double)z * L->c);
             }
     static const int face_dir[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0},
                                        {0, 1, 0},  {0, 0, -1}, {0, 0, 1}};
     size_t t = 0;
-    for (int z = 0; z < L.m[2]; z++)
-        for (int y = 0; y < L.m[1]; y++)
-            for (int x = 0; x < L.m[0]; x++) {
-                uint16_t l = cell_at(&L, x, y, z);
+    for (int z = 0; z < L->m[2]; z++)
+        for (int y = 0; y < L->m[1]; y++)
+            for (int x = 0; x < L->m[0]; x++) {
+                uint16_t l = pp_cells_at(L, x, y, z);
                 if (l == PP_VOXEL_OUTSIDE)
                     continue;
                 uint32_t corner[8];
@@ -244,13 +115,9 @@ pose_status pp_tet_lattice(const pp_voxels *vox, const pp_mesh *skin, const pp_t
                         out->tets[4 * t + q] = corner[kuhn[k][q]];
                     out->labels[t] = tl;
                 }
-                if (l >= PP_VOXEL_BONE0)
-                    for (int k = 0; k < 8; k++)
-                        near_bone[corner[k]] = 1;
-                /* Outer faces: their corners are snapped along the summed normals. */
                 for (int f = 0; f < 6; f++) {
                     const int *d = face_dir[f];
-                    if (cell_at(&L, x + d[0], y + d[1], z + d[2]) != PP_VOXEL_OUTSIDE)
+                    if (pp_cells_at(L, x + d[0], y + d[1], z + d[2]) != PP_VOXEL_OUTSIDE)
                         continue;
                     int axis = f / 2, side = f & 1;
                     for (int k = 0; k < 8; k++) {
@@ -264,16 +131,77 @@ pose_status pp_tet_lattice(const pp_voxels *vox, const pp_mesh *skin, const pp_t
                 }
             }
     free(vid);
-    free(L.cell);
-    /* Bone that reaches the skin keeps its voxel boundary: the skin is not its surface. */
-    for (size_t i = 0; i < nv; i++)
-        if (near_bone[i])
-            dir[3 * i] = dir[3 * i + 1] = dir[3 * i + 2] = 0;
-    free(near_bone);
+    *dir_out = dir;
+    return POSE_OK;
+}
+
+static pose_status build(const pp_cells *L, int grading, pp_tetmesh *out, int8_t **dir)
+{
+    return grading > 0 ? pp_tet_octree_build(L, grading, out, dir) : pp_tet_kuhn_build(L, out, dir);
+}
+
+pose_status pp_tet_lattice(const pp_voxels *vox, const pp_mesh *skin, const pp_tet_options *opt,
+                           pp_tetmesh *out, char *err, size_t errlen)
+{
+    if (!vox || !out || !vox->labels)
+        return POSE_ERR_INVALID_ARGUMENT;
+    memset(out, 0, sizeof *out);
+    pp_tet_options def = {0};
+    if (!opt)
+        opt = &def;
+    int grading = opt->grading < 0 ? 0 : opt->grading > PP_TET_MAX_GRADING ? PP_TET_MAX_GRADING
+                                                                           : opt->grading;
+    size_t body = 0, nvox = (size_t)vox->nx * vox->ny * vox->nz;
+    for (size_t i = 0; i < nvox; i++)
+        body += vox->labels[i] != PP_VOXEL_OUTSIDE;
+    if (body == 0) {
+        if (err && errlen)
+            snprintf(err, errlen, "tetrahedralize: the voxel image has no body voxel");
+        return POSE_ERR_INVALID_DATA;
+    }
+
+    pp_cells L = {0};
+    int8_t *dir = NULL;
+    double c = vox->spacing;
+    if (opt->target_vertices)
+        c = vox->spacing * cbrt((double)body / (double)opt->target_vertices);
+    /* A few tries: each count corrects the cell size (the surface layer adds
+     * vertices a volume estimate does not see; a graded mesh is mostly
+     * surface, so its count goes with the square of the size). */
     pose_status s = POSE_OK;
+    for (int pass = 0; pass < 4; pass++) {
+        pp_tetmesh_free(out);
+        free(dir);
+        dir = NULL;
+        s = pp_cells_label(vox, c, &L);
+        if (s == POSE_OK)
+            s = build(&L, grading, out, &dir);
+        if (s != POSE_OK || !opt->target_vertices)
+            break;
+        double ratio = (double)out->vertex_count / (double)opt->target_vertices;
+        if (ratio > 0.93 && ratio < 1.07)
+            break;
+        c *= grading > 0 ? sqrt(ratio) : cbrt(ratio);
+    }
+    double cell = L.c;
+    pp_cells_free(&L);
+    if (s != POSE_OK) {
+        free(dir);
+        pp_tetmesh_free(out);
+        if (err && errlen)
+            snprintf(err, errlen, s == POSE_ERR_OUT_OF_MEMORY
+                                      ? "tetrahedralize: out of memory"
+                                      : "tetrahedralize: the mesh exceeds 32-bit indices");
+        return s;
+    }
+    /* Bone that reaches the skin keeps its voxel boundary: the skin is not its surface. */
+    for (size_t t = 0; t < out->tet_count; t++)
+        if (out->labels[t] != 0)
+            for (int k = 0; k < 4; k++)
+                memset(dir + 3 * (size_t)out->tets[4 * t + k], 0, 3);
     if (skin && !opt->no_snap) {
         size_t moved = 0;
-        s = pp_tet_snap(out, skin, dir, (float)(2.0 * L.c), &moved);
+        s = pp_tet_snap(out, skin, dir, (float)(2.0 * cell), &moved);
         if (s != POSE_OK && err && errlen)
             snprintf(err, errlen, "tetrahedralize: out of memory while snapping");
     }

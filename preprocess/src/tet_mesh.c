@@ -7,6 +7,7 @@
 #include "voxelize.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -61,6 +62,25 @@ static double now_s(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* Bone labels present in the image but on no tet. */
+static size_t lost_labels(const pp_voxels *vox, const pp_tetmesh *t)
+{
+    uint8_t *seen = calloc(65536, 1);
+    if (!seen)
+        return 0;
+    size_t n = (size_t)vox->nx * vox->ny * vox->nz, lost = 0;
+    for (size_t i = 0; i < n; i++)
+        if (vox->labels[i] >= PP_VOXEL_BONE0)
+            seen[vox->labels[i]] = 1;
+    for (size_t i = 0; i < t->tet_count; i++)
+        if (t->labels[i] + 1 < 65536)
+            seen[t->labels[i] + 1] = 0;
+    for (size_t l = PP_VOXEL_BONE0; l < 65536; l++)
+        lost += seen[l];
+    free(seen);
+    return lost;
+}
+
 pose_status pp_tetrahedralize(const pp_voxels *vox, const pp_mesh *skin,
                               const pp_tet_options *opt, pp_tetmesh *out, pp_tet_quality *q,
                               char *err, size_t errlen)
@@ -97,6 +117,7 @@ pose_status pp_tetrahedralize(const pp_voxels *vox, const pp_mesh *skin,
     pp_tet_quality *qq = q ? q : &local;
     pp_tet_quality_measure(out, qq);
     qq->seconds = secs;
+    qq->labels_lost = lost_labels(vox, out);
     if (qq->inverted_count) {
         if (err && errlen)
             snprintf(err, errlen, "tetrahedralize (%s): %zu of %zu tets are inverted or flat",

@@ -3,16 +3,20 @@
  * Tetrahedralize the labelled body. Two backends behind one call:
  *
  *  - PP_TET_LATTICE (built in, Apache-2.0, the default): a Kuhn
- *    (Freudenthal) lattice of the voxel image: every body cell is split into
- *    six congruent tets along its main diagonal, which conforms across cells
- *    without any search, then the outer boundary vertices are snapped onto
- *    the skin surface (each move is backed off until no incident tet loses
- *    more than 90 % of its volume, so nothing inverts). Tet labels are the
- *    cells' voxel labels. The size budget picks the cell size.
+ *    (Freudenthal) lattice of the voxel image, every body cell split into
+ *    six congruent tets along its main diagonal, or with opt->grading > 0 a
+ *    balanced octree that is one cell fine along skin and bone boundaries
+ *    and coarser inside. The outer boundary vertices are then snapped onto
+ *    the skin surface (a move is backed off when an incident tet would
+ *    become a sliver, so nothing inverts). Tet labels are the cells' voxel
+ *    labels. The size budget picks the cell size.
  *  - PP_TET_TETGEN (only when built with POSE_WITH_TETGEN; AGPL-3+): TetGen
- *    meshes the skin surface as a PLC with quality switches ("pq<ratio>a<vol>")
- *    and the centres of bone boundary voxels as inserted points, so the mesh
- *    resolves bones; each tet takes the voxel label at its centroid.
+ *    meshes the voxel image's label boundary (outer surface and bone
+ *    interfaces) as a PLC with "pq<ratio>a<volume>"; each tet takes the voxel
+ *    label at its centroid (exact, the mesh conforms to the voxel faces); the
+ *    outer boundary is snapped onto the skin as above. (The skin itself
+ *    cannot be the PLC: the shared skin self-intersects in 773 triangle
+ *    pairs and the bones are open and cross it.)
  *
  * Labels in pp_tetmesh: 0 soft tissue, j + 1 bone of joint j (voxel label
  * 2 + j). All tets are positively oriented: det[b-a, c-a, d-a] > 0.
@@ -23,6 +27,8 @@
 #include "pp_types.h"
 
 #include <pose/pose.h>
+
+#define PP_TET_MAX_GRADING 4
 
 typedef enum pp_tet_backend {
     PP_TET_DEFAULT = 0, /**< the built-in lattice */
@@ -35,7 +41,10 @@ typedef struct pp_tet_options {
     pp_tet_backend backend;
     size_t target_vertices;  /**< size budget; 0: lattice = voxel grid, TetGen = its own sizing */
     double max_radius_edge;  /**< TetGen -q bound (default 1.414) */
-    int no_snap;             /**< lattice: keep the staircase boundary (for tests) */
+    int grading;             /**< lattice: octree levels of coarsening away from skin and bone
+                                  boundaries (0: uniform Kuhn lattice; 1..PP_TET_MAX_GRADING:
+                                  leaves up to 2^grading cells wide) */
+    int no_snap;             /**< keep the staircase boundary (for tests) */
     int verbose;             /**< TetGen: print its own log to stdout */
 } pp_tet_options;
 

@@ -70,20 +70,23 @@ static pose_status label_bone(const pp_mesh *bone, uint16_t label, pp_voxels *v,
                     continue;
                 size_t g = (size_t)(x + i0[0]) +
                            (size_t)v->nx * ((size_t)(y + i0[1]) + (size_t)v->ny * (z + i0[2]));
-                got++;
                 uint16_t old = v->labels[g];
                 if (old >= PP_VOXEL_BONE0) {
                     if (old != label)
                         r->overlap_voxels++;
+                    else
+                        got++;
                     continue;
                 }
+                got++;
                 if (!in_skin[g])
                     r->bone_voxels_outside_skin++;
                 v->labels[g] = label;
             }
     free(in);
     if (got == 0) {
-        /* Thinner than a voxel: keep the bone by the voxels holding its vertices. */
+        /* Thinner than a voxel, or wholly inside earlier bones: keep the bone
+         * by the voxels holding its vertices. */
         r->thin_bones++;
         size_t marked = 0;
         for (size_t i = 0; i < bone->vertex_count; i++) {
