@@ -121,9 +121,14 @@ int pb_can_rx_read(pb_can_rx *rx, pb_can_frame *f, int64_t *real_ns, uint64_t *n
         if (c->cmsg_type == SO_TIMESTAMPING) {
             struct scm_timestamping ts;
             memcpy(&ts, CMSG_DATA(c), sizeof ts);
-            const struct timespec *t = (ts.ts[2].tv_sec || ts.ts[2].tv_nsec) ? &ts.ts[2] : &ts.ts[0];
-            if (t->tv_sec || t->tv_nsec)
-                stamp = (int64_t)t->tv_sec * 1000000000 + t->tv_nsec;
+            const int64_t sw = (int64_t)ts.ts[0].tv_sec * 1000000000 + ts.ts[0].tv_nsec;
+            const int64_t hw = (int64_t)ts.ts[2].tv_sec * 1000000000 + ts.ts[2].tv_nsec;
+            /* A raw hardware stamp counts on the adapter's clock; trust it only
+             * when the driver has put it on the wall clock (within a second of it). */
+            if (hw && hw > real - 1000000000 && hw < real + 1000000000)
+                stamp = hw;
+            else if (sw)
+                stamp = sw;
         } else if (c->cmsg_type == SO_TIMESTAMP && !stamp) {
             struct timeval tv;
             memcpy(&tv, CMSG_DATA(c), sizeof tv);
