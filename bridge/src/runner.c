@@ -59,7 +59,7 @@ static void note_tick(pb_runner *r, const pb_pose *p, int64_t lag_ns)
     r->stats.lag_ms = (double)lag_ns * 1e-6;
     if (r->stats.lag_ms > r->stats.lag_max_ms)
         r->stats.lag_max_ms = r->stats.lag_ms;
-    if (p->t_ns - r->fps_t0 >= 1000000000 || r->fps_t0 == 0) {
+    if (p->t_ns - r->fps_t0 >= 250000000 || r->fps_t0 == 0) { /* rate over the last quarter second */
         if (r->fps_t0)
             r->stats.fps = (double)(r->stats.ticks - r->fps_ticks0) * 1e9 / (double)(p->t_ns - r->fps_t0);
         r->fps_t0 = p->t_ns;

@@ -36,7 +36,7 @@ typedef struct pb_runner_stats {
     uint64_t ticks;        /**< poses published */
     long frame;            /**< clip frame of the last pose */
     double media_s;        /**< media time of the last pose */
-    double fps;            /**< publish rate over the last second */
+    double fps;            /**< publish rate over the last quarter second */
     double lag_ms;         /**< lateness of the last tick */
     double lag_max_ms;     /**< worst lateness so far */
     pb_source_state state; /**< PB_SOURCE_OK while running, ENDED at the end */

@@ -7,6 +7,7 @@
 #include "bridge_test.h"
 #include "clock.h"
 #include "pb_math.h"
+#include "mocap_source.h"
 #include "runner.h"
 
 static pb_clip *clip131(void)
@@ -268,6 +269,42 @@ static void test_recording_from_thread(void **state)
     assert_non_null(strstr(err.message, "/nonexistent/dir/x.bvh"));
 }
 
+/* a scalar-channel source (here a clip through the source interface, as a
+ * HID or CAN recording would be) on the bridge thread */
+static void test_source_runner(void **state)
+{
+    fixture *f = *state;
+    pb_source *src;
+    pb_mapping *m;
+    pb_runner *r;
+    pb_error err;
+    assert_int_equal(pb_mocap_source_open(f->clip, 0.0, 0, &src, &err), POSE_OK);
+    const char *js = "{\"channels\": [{\"channel\": \"RightElbow.Xrotation\", \"joint\": \"RightElbow\", "
+                     "\"axis\": \"x\", \"calibration\": {\"offset\": 0, \"scale\": 2}}]}";
+    assert_int_equal(pb_mapping_parse(js, strlen(js), "m.json", &m, &err), POSE_OK);
+    pb_runner_options o = {.max_ticks = 25};
+    if (pb_runner_start_source(src, f->rig, m, &o, &r, &err) != POSE_OK)
+        fail_msg("%s", err.message);
+    assert_int_equal(pb_runner_wait(r, 5000), 1);
+    pb_runner_stats st;
+    pb_runner_stats_get(r, &st);
+    assert_int_equal(st.ticks, 25);
+    const pb_pose *p = pb_runner_latest(r, NULL);
+    int j = pb_rig_skel_find(f->rig, "RightElbow"), c = pb_clip_find_joint(f->clip, "RightElbow");
+    assert_true(p->active[j]);
+    assert_int_equal(p->frame, -1);
+    /* the 25th update is frame 24: twice its Xrotation, about x */
+    int k;
+    for (k = 0; k < f->clip->joints[c].chan_count; k++)
+        if (f->clip->joints[c].chan[k] == PB_CH_XROT)
+            break;
+    double want[4], got[4] = {p->q[j][0], p->q[j][1], p->q[j][2], p->q[j][3]};
+    pb_quat_axis_deg(0, 2.0 * pb_clip_frame(f->clip, 24)[f->clip->joints[c].chan_first + k], want);
+    assert_true(bt_quat_angle_deg(got, want) < 1e-4);
+    assert_int_equal(pb_runner_stop(r, &err), POSE_OK); /* destroys the source */
+    pb_mapping_free(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -277,6 +314,7 @@ int main(void)
         cmocka_unit_test(test_pause_seek_step),
         cmocka_unit_test(test_loop_and_end),
         cmocka_unit_test(test_recording_from_thread),
+        cmocka_unit_test(test_source_runner),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
