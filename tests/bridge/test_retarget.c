@@ -132,27 +132,38 @@ static pb_rig_skel *body_template(void)
     return s;
 }
 
-static void test_body_template_limb_directions(void **state)
+/* rig limb (from, to) and the clip joints driving them, per naming */
+static const char *LIMB_RIG[8][2] = {{"shoulder_r", "elbow_r"}, {"elbow_r", "wrist_r"}, {"shoulder_l", "elbow_l"},
+                                     {"elbow_l", "wrist_l"},    {"hip_r", "knee_r"},     {"knee_r", "ankle_r"},
+                                     {"hip_l", "knee_l"},       {"knee_l", "ankle_l"}};
+static const char *LIMB_131[8][2] = {{"RightShoulder", "RightElbow"}, {"RightElbow", "RightWrist"},
+                                     {"LeftShoulder", "LeftElbow"},   {"LeftElbow", "LeftWrist"},
+                                     {"RightHip", "RightKnee"},       {"RightKnee", "RightAnkle"},
+                                     {"LeftHip", "LeftKnee"},         {"LeftKnee", "LeftAnkle"}};
+static const char *LIMB_CGS[8][2] = {{"RightArm", "RightForeArm"}, {"RightForeArm", "RightHand"},
+                                     {"LeftArm", "LeftForeArm"},   {"LeftForeArm", "LeftHand"},
+                                     {"RightUpLeg", "RightLeg"},   {"RightLeg", "RightFoot"},
+                                     {"LeftUpLeg", "LeftLeg"},     {"LeftLeg", "LeftFoot"}};
+static const char *LIMB_ASF[8][2] = {{"rhumerus", "rradius"}, {"rradius", "rwrist"}, {"lhumerus", "lradius"},
+                                     {"lradius", "lwrist"},   {"rfemur", "rtibia"},  {"rtibia", "rfoot"},
+                                     {"lfemur", "ltibia"},    {"ltibia", "lfoot"}};
+
+static void limb_directions(const char *clip_rel, const char *skel_rel, const char *map_name,
+                            const char *limb_clip[8][2], const char *root)
 {
-    (void)state;
-    pb_clip *clip = load("mocap/cmu-bvh/131_01.bvh", NULL);
+    pb_clip *clip = load(clip_rel, skel_rel);
     pb_rig_skel *rig = body_template();
     char p[1024];
     pb_mapping *map;
     pb_retarget *rt;
     pb_error err;
-    if (pb_mapping_load(BT_MAP(p, "cmu131_bvh_to_full_body.json"), &map, &err) != POSE_OK)
+    bt_path(p, sizeof p, "POSE_DATA_DIR", "../bridge/maps/");
+    strncat(p, map_name, sizeof p - strlen(p) - 1);
+    if (pb_mapping_load(p, &map, &err) != POSE_OK)
         fail_msg("%s", err.message);
     if (pb_retarget_create(map, clip, rig, &rt, &err) != POSE_OK)
         fail_msg("%s", err.message);
     assert_int_equal(pb_retarget_mapped_count(rt), 19);
-    /* rig limb (from, to) and the clip joints driving them */
-    static const char *LIMBS[][4] = {
-        {"shoulder_r", "elbow_r", "RightShoulder", "RightElbow"}, {"elbow_r", "wrist_r", "RightElbow", "RightWrist"},
-        {"shoulder_l", "elbow_l", "LeftShoulder", "LeftElbow"},   {"elbow_l", "wrist_l", "LeftElbow", "LeftWrist"},
-        {"hip_r", "knee_r", "RightHip", "RightKnee"},             {"knee_r", "ankle_r", "RightKnee", "RightAnkle"},
-        {"hip_l", "knee_l", "LeftHip", "LeftKnee"},               {"knee_l", "ankle_l", "LeftKnee", "LeftAnkle"},
-    };
     size_t n = (size_t)clip->joint_count;
     double *s = malloc(n * 14 * sizeof(double));
     double (*lq)[4] = (double (*)[4])s, (*lt)[3] = (double (*)[3])(s + 4 * n);
@@ -166,35 +177,46 @@ static void test_body_template_limb_directions(void **state)
         pb_retarget_apply(rt, (const double (*)[4])lq, (const double (*)[3])lt, clip->frame_time, &pose);
         pb_clip_world(clip, (const double (*)[4])lq, (const double (*)[3])lt, cq, cp);
         pb_rig_skel_fk(rig, (const float (*)[4])pose.q, pose.root_t, pose.root_q, rq, rp);
-        for (size_t i = 0; i < sizeof LIMBS / sizeof LIMBS[0]; i++) {
-            int a = pb_rig_skel_find(rig, LIMBS[i][0]), b = pb_rig_skel_find(rig, LIMBS[i][1]);
-            int ca = pb_clip_find_joint(clip, LIMBS[i][2]), cb = pb_clip_find_joint(clip, LIMBS[i][3]);
+        for (size_t i = 0; i < 8; i++) {
+            int a = pb_rig_skel_find(rig, LIMB_RIG[i][0]), b = pb_rig_skel_find(rig, LIMB_RIG[i][1]);
+            int ca = pb_clip_find_joint(clip, limb_clip[i][0]), cb = pb_clip_find_joint(clip, limb_clip[i][1]);
+            assert_true(ca >= 0 && cb >= 0);
             double vr[3] = {rp[b][0] - rp[a][0], rp[b][1] - rp[a][1], rp[b][2] - rp[a][2]};
             /* the clip's direction in rig axes: (x, y, z) Y up, Z forward, X left -> (z, x, y) */
             double vc[3] = {cp[cb][2] - cp[ca][2], cp[cb][0] - cp[ca][0], cp[cb][1] - cp[ca][1]};
             double x[3] = {vr[1] * vc[2] - vr[2] * vc[1], vr[2] * vc[0] - vr[0] * vc[2], vr[0] * vc[1] - vr[1] * vc[0]};
             double ang = atan2(pb_vec_len(x), vr[0] * vc[0] + vr[1] * vc[1] + vr[2] * vc[2]) * PB_RAD2DEG;
             if (ang > 0.001)
-                fail_msg("frame %zu %s->%s points %g deg away from the clip's %s->%s", f, LIMBS[i][0], LIMBS[i][1],
-                         ang, LIMBS[i][2], LIMBS[i][3]);
+                fail_msg("%s frame %zu %s->%s points %g deg away from the clip's %s->%s", clip_rel, f, LIMB_RIG[i][0],
+                         LIMB_RIG[i][1], ang, limb_clip[i][0], limb_clip[i][1]);
             worst = ang > worst ? ang : worst;
         }
     }
     /* root motion: the clip's root displacement from its reference (the Hips
      * OFFSET), in metres (x 0.056444), clip (x, y, z) -> rig (z, x, y) */
-    int hips = pb_clip_find_joint(clip, "Hips");
+    int hips = pb_clip_find_joint(clip, root);
     const double *o = clip->joints[hips].offset;
     assert_near(pose.root_t[0], 0.056444 * (cp[hips][2] - o[2]), 1e-6);
     assert_near(pose.root_t[1], 0.056444 * (cp[hips][0] - o[0]), 1e-6);
     assert_near(pose.root_t[2], 0.056444 * (cp[hips][1] - o[1]), 1e-6);
     walked = sqrt(pose.root_t[0] * pose.root_t[0] + pose.root_t[1] * pose.root_t[1]);
-    print_message("131_01 onto the body template: worst limb direction %.2g deg; walked %.2f m\n", worst, walked);
+    print_message("%s onto the body template: worst limb direction %.2g deg; root moved %.2f m\n", clip_rel, worst,
+                  walked);
     pb_pose_free(&pose);
     free(s);
     pb_retarget_free(rt);
     pb_mapping_free(map);
     pb_rig_skel_free(rig);
     pb_clip_free(clip);
+}
+
+static void test_body_template_limb_directions(void **state)
+{
+    (void)state;
+    limb_directions("mocap/cmu-bvh/131_01.bvh", NULL, "cmu131_bvh_to_full_body.json", LIMB_131, "Hips");
+    limb_directions("mocap/cmu-bvh/01_01.bvh", NULL, "cmu_cgspeed_bvh_to_full_body.json", LIMB_CGS, "Hips");
+    limb_directions("mocap/cmu-asf-amc/01_01.amc", "mocap/cmu-asf-amc/01.asf", "cmu_asf_to_full_body.json", LIMB_ASF,
+                    "root");
 }
 
 static void test_recording_replays_same_targets(void **state)
