@@ -117,6 +117,11 @@ pose_status pose__rig_prepare(pose_rig *rig)
         total += rig->tissues[t].vertex_count;
     const size_t tb = (total + B - 1) / B;
     const int narrow = nj <= 256;
+    /* The kernels index vertex coordinates with 32-bit offsets (3 * index). */
+    if (nv > (size_t)INT32_MAX / 4)
+        return pose__fail(POSE_ERR_UNSUPPORTED,
+                          "tet mesh of %zu vertices: the runtime handles at most %d", nv,
+                          INT32_MAX / 4);
 
     /* One block of memory: header, skin blocks, tissue blocks, rest frames. */
     size_t off = align64(sizeof(struct pose__rig_runtime));
