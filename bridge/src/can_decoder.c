@@ -61,11 +61,14 @@ struct pb_can_decoder {
     pb_can_stats stats;
     int64_t first_ns; /* first frame seen, INT64_MIN before */
     int64_t now_ns;
+    int64_t last_scan_ns;
     char notice[200];
     pb_source_state last_state;
     char last_message[256];
     int reported_once;
 };
+
+static void scan(pb_can_decoder *d, int64_t now, int force);
 
 static int wanted(const pb_can_config *cfg, const char *name, unsigned char *used)
 {
@@ -321,6 +324,7 @@ void pb_can_decoder_reset(pb_can_decoder *d)
     }
     d->first_ns = INT64_MIN;
     d->now_ns = INT64_MIN;
+    d->last_scan_ns = INT64_MIN;
     d->stats.bus = PB_CAN_BUS_ACTIVE;
     d->notice[0] = '\0';
 }
@@ -443,12 +447,12 @@ size_t pb_can_decoder_feed(pb_can_decoder *d, const pb_can_frame *f, pb_update *
             d->stats.bus = e.state;
         if (e.rx_overflow)
             d->stats.dropped++;
-        pb_can_decoder_tick(d, f->t_ns);
+        scan(d, f->t_ns, 0);
         return 0;
     }
     if (f->flags & PB_CAN_RTR) {
         d->stats.remote_frames++;
-        pb_can_decoder_tick(d, f->t_ns);
+        scan(d, f->t_ns, 0);
         return 0;
     }
     /* Frames arriving prove the controller is back on the bus after bus-off
@@ -489,18 +493,24 @@ size_t pb_can_decoder_feed(pb_can_decoder *d, const pb_can_frame *f, pb_update *
         if (k)
             d->stats.decoded++;
     }
-    pb_can_decoder_tick(d, f->t_ns);
+    scan(d, f->t_ns, 0);
     out->count = k;
     return k;
 }
 
-void pb_can_decoder_tick(pb_can_decoder *d, int64_t now)
+/* Silence checks. Frames call it with force 0: a node that speaks turns
+ * alive in touch(), so scanning every node for timeouts once per
+ * millisecond of bus time is enough, and keeps big DBCs cheap per frame. */
+static void scan(pb_can_decoder *d, int64_t now, int force)
 {
     if (now < d->now_ns)
         return; /* clocks only move forward; a reordered stamp changes nothing */
     d->now_ns = now;
     if (d->first_ns == INT64_MIN)
         return;
+    if (!force && d->last_scan_ns != INT64_MIN && now - d->last_scan_ns < 1000000)
+        return;
+    d->last_scan_ns = now;
     for (size_t i = 0; i < d->node_count; i++) {
         can_node *n = &d->nodes[i];
         /* A node never heard counts from the bus's first frame. */
@@ -517,6 +527,8 @@ void pb_can_decoder_tick(pb_can_decoder *d, int64_t now)
             n->state = n->last_ns == INT64_MIN ? PB_CAN_NODE_NEVER : PB_CAN_NODE_ALIVE;
     }
 }
+
+void pb_can_decoder_tick(pb_can_decoder *d, int64_t now) { scan(d, now, 1); }
 
 void pb_can_decoder_add_dropped(pb_can_decoder *d, uint64_t n)
 {
