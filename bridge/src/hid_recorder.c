@@ -194,7 +194,7 @@ static pose_status event(reader *r, const char *p, const char *end)
         rec->events = ev;
         r->event_cap = cap;
     }
-    if (rec->data_len + n > r->data_cap) {
+    if (rec->data_len + n > r->data_cap || !rec->data) { /* allocated even for empty reports */
         size_t cap = r->data_cap ? r->data_cap * 2 : 4096;
         while (cap < rec->data_len + n)
             cap *= 2;

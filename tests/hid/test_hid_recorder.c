@@ -140,6 +140,21 @@ static void test_two_devices(void **state)
     pb_hid_recording_free(rec);
 }
 
+/* An empty first report (found by fuzzing: the data pool must exist even then). */
+static void test_empty_report(void **state)
+{
+    (void)state;
+    const char text[] = "R: 2 05 01\nE: 0.0 0\nE: 0.5 1 7f\n";
+    pb_hid_recording *rec;
+    pb_error err;
+    assert_int_equal(pb_hid_recording_parse(text, sizeof text - 1, "empty.hid", &rec, &err), POSE_OK);
+    assert_int_equal(rec->event_count, 2);
+    assert_non_null(rec->data);
+    assert_int_equal(rec->events[0].len, 0);
+    assert_int_equal(rec->data[rec->events[1].offset], 0x7F);
+    pb_hid_recording_free(rec);
+}
+
 static char *read_text(const char *path, size_t *n)
 {
     FILE *f = fopen(path, "rb");
@@ -247,6 +262,7 @@ int main(void)
         cmocka_unit_test(test_invalid),
         cmocka_unit_test(test_old_style),
         cmocka_unit_test(test_two_devices),
+        cmocka_unit_test(test_empty_report),
         cmocka_unit_test(test_write_round_trip),
         cmocka_unit_test(test_bundled_recordings),
     };
