@@ -76,6 +76,42 @@ static int convert(const struct canfd_frame *k, size_t n, pb_can_frame *f)
     return 1;
 }
 
+int64_t pb_can_rx_ancillary(pb_can_rx *rx, const struct msghdr *msg, int64_t real, uint64_t *new_drops)
+{
+    int64_t stamp = 0;
+    *new_drops = 0;
+    for (struct cmsghdr *c = CMSG_FIRSTHDR(msg); c; c = CMSG_NXTHDR((struct msghdr *)msg, c)) {
+        if (c->cmsg_level != SOL_SOCKET)
+            continue;
+        if (c->cmsg_type == SO_TIMESTAMPING) {
+            struct scm_timestamping ts;
+            memcpy(&ts, CMSG_DATA(c), sizeof ts);
+            const int64_t sw = (int64_t)ts.ts[0].tv_sec * 1000000000 + ts.ts[0].tv_nsec;
+            const int64_t hw = (int64_t)ts.ts[2].tv_sec * 1000000000 + ts.ts[2].tv_nsec;
+            /* A raw hardware stamp counts on the adapter's clock; trust it only
+             * when the driver has put it on the wall clock (within a second of it). */
+            if (hw && hw > real - 1000000000 && hw < real + 1000000000)
+                stamp = hw;
+            else if (sw)
+                stamp = sw;
+        } else if (c->cmsg_type == SO_TIMESTAMP && !stamp) {
+            struct timeval tv;
+            memcpy(&tv, CMSG_DATA(c), sizeof tv);
+            stamp = (int64_t)tv.tv_sec * 1000000000 + (int64_t)tv.tv_usec * 1000;
+        } else if (c->cmsg_type == SO_RXQ_OVFL) {
+            uint32_t ovfl;
+            memcpy(&ovfl, CMSG_DATA(c), sizeof ovfl);
+            /* The counter is cumulative per socket and wraps at 2^32. */
+            const uint32_t d = rx->have_ovfl ? ovfl - rx->ovfl : ovfl;
+            rx->ovfl = ovfl;
+            rx->have_ovfl = 1;
+            rx->dropped += d;
+            *new_drops = d;
+        }
+    }
+    return stamp;
+}
+
 int pb_can_rx_read(pb_can_rx *rx, pb_can_frame *f, int64_t *real_ns, uint64_t *new_drops,
                    int timeout_ms)
 {
@@ -114,37 +150,10 @@ int pb_can_rx_read(pb_can_rx *rx, pb_can_frame *f, int64_t *real_ns, uint64_t *n
         return -1;
     }
     const int64_t mono = pb_can_mono_ns(), real = pb_can_real_ns();
-    int64_t stamp = 0;
-    for (struct cmsghdr *c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c)) {
-        if (c->cmsg_level != SOL_SOCKET)
-            continue;
-        if (c->cmsg_type == SO_TIMESTAMPING) {
-            struct scm_timestamping ts;
-            memcpy(&ts, CMSG_DATA(c), sizeof ts);
-            const int64_t sw = (int64_t)ts.ts[0].tv_sec * 1000000000 + ts.ts[0].tv_nsec;
-            const int64_t hw = (int64_t)ts.ts[2].tv_sec * 1000000000 + ts.ts[2].tv_nsec;
-            /* A raw hardware stamp counts on the adapter's clock; trust it only
-             * when the driver has put it on the wall clock (within a second of it). */
-            if (hw && hw > real - 1000000000 && hw < real + 1000000000)
-                stamp = hw;
-            else if (sw)
-                stamp = sw;
-        } else if (c->cmsg_type == SO_TIMESTAMP && !stamp) {
-            struct timeval tv;
-            memcpy(&tv, CMSG_DATA(c), sizeof tv);
-            stamp = (int64_t)tv.tv_sec * 1000000000 + (int64_t)tv.tv_usec * 1000;
-        } else if (c->cmsg_type == SO_RXQ_OVFL) {
-            uint32_t ovfl;
-            memcpy(&ovfl, CMSG_DATA(c), sizeof ovfl);
-            /* The counter is cumulative per socket and wraps at 2^32. */
-            const uint32_t d = rx->have_ovfl ? ovfl - rx->ovfl : ovfl;
-            rx->ovfl = ovfl;
-            rx->have_ovfl = 1;
-            rx->dropped += d;
-            if (new_drops)
-                *new_drops = d;
-        }
-    }
+    uint64_t d = 0;
+    const int64_t stamp = pb_can_rx_ancillary(rx, &msg, real, &d);
+    if (new_drops)
+        *new_drops = d;
     if (!convert(&k, (size_t)n, f)) {
         rx->bad++;
         return -2;

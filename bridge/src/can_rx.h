@@ -10,6 +10,7 @@
 #define POSE_BRIDGE_CAN_RX_H
 
 #include <stdint.h>
+#include <sys/socket.h>
 
 #include "can_frame.h"
 
@@ -36,6 +37,14 @@ void pb_can_rx_init(pb_can_rx *rx, int fd);
  */
 int pb_can_rx_read(pb_can_rx *rx, pb_can_frame *f, int64_t *real_ns, uint64_t *new_drops,
                    int timeout_ms);
+
+/**
+ * The ancillary data of one received frame: returns its wall-clock receive
+ * stamp (0 when none; hardware stamps only when on the wall clock, which
+ * `real`, the wall clock now, tells) and updates the drop counter from
+ * SO_RXQ_OVFL, with the frames lost since the previous one in *new_drops.
+ */
+int64_t pb_can_rx_ancillary(pb_can_rx *rx, const struct msghdr *msg, int64_t real, uint64_t *new_drops);
 
 /** Current CLOCK_MONOTONIC and CLOCK_REALTIME in ns. */
 int64_t pb_can_mono_ns(void);

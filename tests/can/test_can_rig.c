@@ -14,6 +14,7 @@
 
 #include <cmocka.h>
 
+#include "can_mapping.h"
 #include "can_source.h"
 #include "mapping.h"
 #include "rig_skel.h"
@@ -355,6 +356,23 @@ static void test_bar_mapping(void **state)
     pb_chanmap *cm = NULL;
     if (pb_chanmap_create(map, src->channels, src->channel_count, skel, &cm, &err) != POSE_OK)
         fail_msg("%s", err.message);
+    /* the mapping alone also selects what the bus delivers and the kernel passes */
+    pb_can_bus *mapped = load_bus("bridge/maps/can_rig_fullbody.json");
+    assert_int_equal(pb_can_bus_select_mapped(mapped, map, &err), POSE_OK);
+    pb_can_decoder *dec = NULL;
+    assert_int_equal(pb_can_decoder_create(pb_can_bus_config(mapped), &dec, &err), POSE_OK);
+    size_t nf, nc;
+    const pb_can_filter *flt = pb_can_decoder_filters(dec, &nf);
+    pb_can_decoder_channels(dec, &nc);
+    assert_int_equal(nc, 3);
+    assert_int_equal(nf, 4); /* ANKLE_L's TPDO1 and heartbeat, HIP_L, KNEE_L */
+    assert_int_equal(flt[0].id, 0x1A3);
+    assert_int_equal(flt[1].id, 0x723);
+    assert_int_equal(flt[2].id, 0x109);
+    assert_int_equal(flt[3].id, 0x10B);
+    pb_can_decoder_free(dec);
+    pb_can_bus_free(mapped);
+
     replay_until(src, cm, 800000000);
     assert_true(fabs(pb_chanmap_value(cm, 1) - -90.0) < 0.1); /* knee, inverted, unfiltered */
     assert_true(fabs(pb_chanmap_value(cm, 2) - -15.0) < 0.2); /* ankle encoder */

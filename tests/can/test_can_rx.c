@@ -15,8 +15,12 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <sys/time.h>
+#include <time.h>
+
 #include <linux/can.h>
 #include <linux/can/error.h>
+#include <linux/errqueue.h>
 
 #include <cmocka.h>
 
@@ -100,6 +104,75 @@ static void test_rx_loop(void **state)
     assert_int_equal(pb_can_rx_read(&rx, &f, NULL, &drops, 100), -1);
     assert_int_equal(errno, EPIPE);
     close(sv[0]);
+}
+
+/* Ancillary data as the kernel attaches it to a raw CAN socket's frames
+ * (a socketpair cannot carry these), built by hand. */
+static void test_ancillary(void **state)
+{
+    (void)state;
+    pb_can_rx rx;
+    pb_can_rx_init(&rx, -1);
+    union {
+        char buf[CMSG_SPACE(sizeof(struct scm_timestamping)) + CMSG_SPACE(sizeof(struct timeval)) +
+                 CMSG_SPACE(sizeof(uint32_t))];
+        struct cmsghdr align;
+    } ctrl;
+    struct msghdr msg;
+    const int64_t real = 1763769600LL * 1000000000;
+    uint64_t drops;
+    /* SO_TIMESTAMP (microseconds) and an overflow counter of 5 */
+    memset(&ctrl, 0, sizeof ctrl);
+    memset(&msg, 0, sizeof msg);
+    msg.msg_control = ctrl.buf;
+    msg.msg_controllen = CMSG_SPACE(sizeof(struct timeval)) + CMSG_SPACE(sizeof(uint32_t));
+    struct cmsghdr *c = CMSG_FIRSTHDR(&msg);
+    c->cmsg_level = SOL_SOCKET;
+    c->cmsg_type = SO_TIMESTAMP;
+    c->cmsg_len = CMSG_LEN(sizeof(struct timeval));
+    struct timeval tv = {1763769599, 250000};
+    memcpy(CMSG_DATA(c), &tv, sizeof tv);
+    c = CMSG_NXTHDR(&msg, c);
+    c->cmsg_level = SOL_SOCKET;
+    c->cmsg_type = SO_RXQ_OVFL;
+    c->cmsg_len = CMSG_LEN(sizeof(uint32_t));
+    uint32_t ovfl = 5;
+    memcpy(CMSG_DATA(c), &ovfl, sizeof ovfl);
+    assert_true(pb_can_rx_ancillary(&rx, &msg, real, &drops) == 1763769599250000000LL);
+    assert_int_equal(drops, 5);
+    /* the counter is cumulative: 12 means 7 more; then it wraps past 2^32 */
+    ovfl = 12;
+    memcpy(CMSG_DATA(c), &ovfl, sizeof ovfl);
+    pb_can_rx_ancillary(&rx, &msg, real, &drops);
+    assert_int_equal(drops, 7);
+    rx.ovfl = 0xFFFFFFFEu;
+    ovfl = 3;
+    memcpy(CMSG_DATA(c), &ovfl, sizeof ovfl);
+    pb_can_rx_ancillary(&rx, &msg, real, &drops);
+    assert_int_equal(drops, 5);
+    assert_int_equal(rx.dropped, 17);
+    /* SO_TIMESTAMPING: a hardware stamp on the wall clock wins, one on the adapter's own clock does not */
+    memset(&ctrl, 0, sizeof ctrl);
+    msg.msg_controllen = CMSG_SPACE(sizeof(struct scm_timestamping));
+    c = CMSG_FIRSTHDR(&msg);
+    c->cmsg_level = SOL_SOCKET;
+    c->cmsg_type = SO_TIMESTAMPING;
+    c->cmsg_len = CMSG_LEN(sizeof(struct scm_timestamping));
+    struct scm_timestamping ts;
+    memset(&ts, 0, sizeof ts);
+    ts.ts[0].tv_sec = 1763769599;
+    ts.ts[0].tv_nsec = 900000000;
+    ts.ts[2].tv_sec = 1763769599;
+    ts.ts[2].tv_nsec = 899999000;
+    memcpy(CMSG_DATA(c), &ts, sizeof ts);
+    assert_true(pb_can_rx_ancillary(&rx, &msg, real, &drops) == 1763769599899999000LL);
+    assert_int_equal(drops, 0);
+    ts.ts[2].tv_sec = 12345; /* adapter uptime */
+    memcpy(CMSG_DATA(c), &ts, sizeof ts);
+    assert_true(pb_can_rx_ancillary(&rx, &msg, real, &drops) == 1763769599900000000LL);
+    /* nothing attached */
+    msg.msg_controllen = 0;
+    assert_true(pb_can_rx_ancillary(&rx, &msg, real, &drops) == 0);
 }
 
 typedef struct status_log {
@@ -266,6 +339,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_open_errors),
+        cmocka_unit_test(test_ancillary),
         cmocka_unit_test(test_rx_loop),
         cmocka_unit_test(test_live_source),
     };
