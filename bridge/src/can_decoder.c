@@ -445,6 +445,10 @@ size_t pb_can_decoder_feed(pb_can_decoder *d, const pb_can_frame *f, pb_update *
         d->stats.error_frames++;
         if (e.has_state)
             d->stats.bus = e.state;
+        if (f->len >= 8) { /* the kernel's error frames carry the counters in bytes 6 and 7 */
+            d->stats.tx_errors = e.tx_errors;
+            d->stats.rx_errors = e.rx_errors;
+        }
         if (e.rx_overflow)
             d->stats.dropped++;
         scan(d, f->t_ns, 0);
@@ -562,7 +566,11 @@ int pb_can_decoder_health(pb_can_decoder *d, pb_source_state *state, char *messa
     }
     if (d->stats.bus == PB_CAN_BUS_OFF || d->stats.bus == PB_CAN_BUS_PASSIVE) {
         s = PB_SOURCE_FAULT;
-        snprintf(msg, sizeof msg, "CAN controller %s", pb_can_bus_state_name(d->stats.bus));
+        if (d->stats.tx_errors || d->stats.rx_errors)
+            snprintf(msg, sizeof msg, "CAN controller %s (tx errors %u, rx errors %u)",
+                     pb_can_bus_state_name(d->stats.bus), d->stats.tx_errors, d->stats.rx_errors);
+        else
+            snprintf(msg, sizeof msg, "CAN controller %s", pb_can_bus_state_name(d->stats.bus));
     } else if (silent) {
         s = PB_SOURCE_STALE;
         const int64_t hb = first->last_hb_ns == INT64_MIN ? d->first_ns : first->last_hb_ns;

@@ -67,6 +67,7 @@ typedef struct pb_can_stats {
     uint64_t dropped;       /**< frames the receiver lost (SO_RXQ_OVFL, controller overflow) */
     uint64_t bad_lines;     /**< replay: malformed log lines */
     pb_can_bus_state bus;
+    uint8_t tx_errors, rx_errors; /**< controller error counters from the latest error frame with them */
 } pb_can_stats;
 
 typedef enum pb_can_node_state {

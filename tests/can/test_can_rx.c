@@ -263,7 +263,7 @@ static void test_live_source(void **state)
     send_classic(sv[1], 0x10B, KNEE_90, 8);
     assert_int_equal(src->ops->read(src, &u, 200), 1);
     assert_int_equal(src->state, PB_SOURCE_FAULT);
-    assert_non_null(strstr(src->message, "error-passive"));
+    assert_string_equal(src->message, "CAN controller error-passive (tx errors 8, rx errors 130)");
     /* bus-off */
     send_error(sv[1], CAN_ERR_BUSOFF, 0, 0, 0);
     assert_int_equal(src->ops->read(src, &u, 10), 0);
