@@ -232,39 +232,45 @@ static pose_status parse_motion(bvh_parser *P)
     return POSE_OK;
 }
 
-pose_status pb_bvh_parse(const char *text, size_t size, const char *name, pb_clip **out, pb_error *err)
+/* Parse a NUL-terminated buffer of `size` bytes (text[size] == '\0'). */
+static pose_status parse_terminated(const char *text, size_t size, const char *name, pb_clip **out, pb_error *err)
 {
-    if (!out || (!text && size))
-        return pb_fail(err, POSE_ERR_INVALID_ARGUMENT, "pb_bvh_parse: NULL argument");
-    *out = NULL;
-    char *copy = malloc(size + 1);
-    if (!copy)
-        return pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "%s: out of memory", name ? name : "<memory>");
-    if (size)
-        memcpy(copy, text, size);
-    copy[size] = '\0';
     bvh_parser P = {.cap = 64, .err = err};
-    pb_text_init(&P.t, copy, size, name);
+    pb_text_init(&P.t, text, size, name);
     P.clip = pb_clip_alloc(P.cap);
-    pose_status s = POSE_ERR_OUT_OF_MEMORY;
-    if (P.clip) {
-        snprintf(P.clip->format, sizeof P.clip->format, "bvh");
-        snprintf(P.clip->path, sizeof P.clip->path, "%s", P.t.name);
-        pb_token tk = pb_text_next(&P.t, 0);
-        if (!pb_token_is(tk, "HIERARCHY"))
-            s = expected(&P, tk, "HIERARCHY");
-        else if ((s = parse_hierarchy(&P)) == POSE_OK)
-            s = parse_motion(&P);
-    } else {
-        pb_fail(err, s, "%s: out of memory", P.t.name);
-    }
-    free(copy);
+    if (!P.clip)
+        return pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "%s: out of memory", P.t.name);
+    snprintf(P.clip->format, sizeof P.clip->format, "bvh");
+    snprintf(P.clip->path, sizeof P.clip->path, "%s", P.t.name);
+    pose_status s;
+    pb_token tk = pb_text_next(&P.t, 0);
+    if (!pb_token_is(tk, "HIERARCHY"))
+        s = expected(&P, tk, "HIERARCHY");
+    else if ((s = parse_hierarchy(&P)) == POSE_OK)
+        s = parse_motion(&P);
     if (s != POSE_OK) {
         pb_clip_free(P.clip);
         return s;
     }
     *out = P.clip;
     return POSE_OK;
+}
+
+pose_status pb_bvh_parse(const char *text, size_t size, const char *name, pb_clip **out, pb_error *err)
+{
+    if (!out || (!text && size))
+        return pb_fail(err, POSE_ERR_INVALID_ARGUMENT, "pb_bvh_parse: NULL argument");
+    *out = NULL;
+    /* the tokenizer relies on a terminating NUL (number parsing stops there) */
+    char *copy = malloc(size + 1);
+    if (!copy)
+        return pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "%s: out of memory", name ? name : "<memory>");
+    if (size)
+        memcpy(copy, text, size);
+    copy[size] = '\0';
+    pose_status s = parse_terminated(copy, size, name, out, err);
+    free(copy);
+    return s;
 }
 
 pose_status pb_bvh_load(const char *path, pb_clip **out, pb_error *err)
@@ -278,7 +284,7 @@ pose_status pb_bvh_load(const char *path, pb_clip **out, pb_error *err)
     pose_status s = pb_read_file(path, BVH_MAX_FILE, &data, &size, err);
     if (s)
         return s;
-    s = pb_bvh_parse(data, size, path, out, err);
+    s = parse_terminated(data, size, path, out, err); /* pb_read_file terminates the buffer */
     free(data);
     return s;
 }
