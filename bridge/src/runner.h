@@ -30,6 +30,8 @@ typedef struct pb_runner_options {
     double start_s;    /**< initial media time */
     int start_paused;
     const char *record_path; /**< BVH of the applied joint angles, or NULL */
+    int rt_priority;   /**< > 0: run the bridge thread SCHED_FIFO at this priority (1..99)
+                            when the system allows it (see pb_runner_stats.realtime) */
 } pb_runner_options;
 
 typedef struct pb_runner_stats {
@@ -41,6 +43,7 @@ typedef struct pb_runner_stats {
     double lag_max_ms;     /**< worst lateness so far */
     pb_source_state state; /**< PB_SOURCE_OK while running, ENDED at the end */
     int running;
+    int realtime;          /**< the thread got the SCHED_FIFO priority it asked for */
 } pb_runner_stats;
 
 typedef struct pb_runner pb_runner;

@@ -30,6 +30,7 @@ static void help(FILE *f)
             "  --duration S    stop after S seconds of clip time\n"
             "  --start S       start at clip time S\n"
             "  --out FILE.bvh  record the applied joint angles (flushed every frame)\n"
+            "  --rt-priority N run the bridge thread SCHED_FIFO at priority N when allowed\n"
             "  --json          print a JSON summary on stdout\n"
             "  --quiet         no status line\n"
             "Status line (stderr): frame, bridge fps, lag of the bridge thread's wake-ups.\n");
@@ -38,7 +39,7 @@ static void help(FILE *f)
 typedef struct replay_args {
     const char *clip, *skeleton, *rig, *map, *out;
     double speed, rate, host_rate, duration, start;
-    long frames;
+    long frames, rt_priority;
     int afap, loop, json, quiet;
 } replay_args;
 
@@ -81,6 +82,11 @@ static int parse(int argc, char **argv, replay_args *a)
         else if (strcmp(s, "--frames") == 0 && v) {
             a->frames = strtol(v, &e, 10);
             if (*e || a->frames < 0)
+                return -1;
+            i++;
+        } else if (strcmp(s, "--rt-priority") == 0 && v) {
+            a->rt_priority = strtol(v, &e, 10);
+            if (*e || a->rt_priority < 1 || a->rt_priority > 99)
                 return -1;
             i++;
         } else if (strcmp(s, "--afap") == 0)
@@ -156,7 +162,7 @@ static int run(int argc, char **argv)
         s = a.map ? pb_mapping_load(a.map, &map, &err) : pb_mapping_identity(&map, &err);
     pb_runner_options o = {.speed = a.speed, .afap = a.afap, .loop = a.loop, .rate_hz = a.rate,
                            .max_ticks = a.frames, .max_media_s = a.duration, .start_s = a.start,
-                           .record_path = a.out};
+                           .record_path = a.out, .rt_priority = (int)a.rt_priority};
     if (!s)
         s = pb_runner_start_clip(clip, skel, map, &o, &run, &err);
     if (s) {
@@ -224,10 +230,10 @@ static int run(int argc, char **argv)
         pb_cli_json_string(stdout, a.clip);
         printf(", \"rig_joints\": %d, \"ticks\": %llu, \"last_frame\": %ld, \"media_s\": %.6f, "
                "\"host_frames\": %llu, \"poses_applied\": %llu, \"clamped\": %ld, \"lag_p50_ms\": %.4f, "
-               "\"lag_p99_ms\": %.4f, \"lag_max_ms\": %.4f, \"state\": \"%s\"",
+               "\"lag_p99_ms\": %.4f, \"lag_max_ms\": %.4f, \"realtime\": %s, \"state\": \"%s\"",
                skel->joint_count, (unsigned long long)fin.ticks, fin.frame, fin.media_s,
                (unsigned long long)host_frames, (unsigned long long)applied, clamped, p50, p99, fin.lag_max_ms,
-               pb_source_state_name(fin.state));
+               fin.realtime ? "true" : "false", pb_source_state_name(fin.state));
         if (a.out) {
             printf(", \"recording\": ");
             pb_cli_json_string(stdout, a.out);
