@@ -16,18 +16,10 @@
 #define WSCALE (1.0f / 32768.0f)
 #define PAL_STRIDE 16 /* floats per pose__skin_joint */
 
-/* Palette offsets (in floats) of joint k's entries, for the lanes of block b. */
-static POSE__INLINE void joint_offsets(const pose__skin_mesh *m, size_t b, size_t k,
-                                       int32_t idx[8])
-{
-    size_t row = (b * m->influences + k) * POSE__BLOCK;
-    if (m->joints8)
-        for (int l = 0; l < 8; l++)
-            idx[l] = (int32_t)m->joints8[row + (size_t)l] * PAL_STRIDE;
-    else
-        for (int l = 0; l < 8; l++)
-            idx[l] = (int32_t)m->joints16[row + (size_t)l] * PAL_STRIDE;
-}
+/* Joint indices of influence k for the lanes of block b. */
+#define joint_row(m, b, k) ((m)->joints + ((b) * (m)->influences + (k)) * POSE__BLOCK)
+/* Entry `off` of the palette rows of the joints in `row`. */
+#define PAL(row, off) V8_GATHER(pf, row, PAL_STRIDE, off)
 
 /* Weights of influence k for the lanes of block b (a macro: vectors are not
  * passed by value, whose ABI differs between the variants). */
@@ -84,20 +76,20 @@ static POSE__INLINE void store_lanes(float *restrict out, size_t b, size_t count
     }
 }
 
-/* x, y, z of the tet vertices at tp + idx[l] (idx = 3 * vertex index). */
+/* x, y, z of the tet vertices idx[0..7] (xyz interleaved at tp). */
 #ifdef __AVX2__
 /* One 16-byte load per lane (its 4th float belongs to the next vertex, or
  * to the slack the caller leaves after the array), then a transpose. */
 #define LOAD_XYZ(tp, idx, X, Y, Z)                                                  \
     do {                                                                            \
-        __m256 r0_ = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((tp) + (idx)[0])), \
-                                          _mm_loadu_ps((tp) + (idx)[4]), 1);        \
-        __m256 r1_ = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((tp) + (idx)[1])), \
-                                          _mm_loadu_ps((tp) + (idx)[5]), 1);        \
-        __m256 r2_ = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((tp) + (idx)[2])), \
-                                          _mm_loadu_ps((tp) + (idx)[6]), 1);        \
-        __m256 r3_ = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((tp) + (idx)[3])), \
-                                          _mm_loadu_ps((tp) + (idx)[7]), 1);        \
+        __m256 r0_ = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((tp) + 3 * (size_t)(idx)[0])), \
+                                          _mm_loadu_ps((tp) + 3 * (size_t)(idx)[4]), 1);        \
+        __m256 r1_ = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((tp) + 3 * (size_t)(idx)[1])), \
+                                          _mm_loadu_ps((tp) + 3 * (size_t)(idx)[5]), 1);        \
+        __m256 r2_ = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((tp) + 3 * (size_t)(idx)[2])), \
+                                          _mm_loadu_ps((tp) + 3 * (size_t)(idx)[6]), 1);        \
+        __m256 r3_ = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps((tp) + 3 * (size_t)(idx)[3])), \
+                                          _mm_loadu_ps((tp) + 3 * (size_t)(idx)[7]), 1);        \
         __m256 t0_ = _mm256_unpacklo_ps(r0_, r1_), t1_ = _mm256_unpackhi_ps(r0_, r1_); \
         __m256 t2_ = _mm256_unpacklo_ps(r2_, r3_), t3_ = _mm256_unpackhi_ps(r2_, r3_); \
         (X) = (pose__v8f)_mm256_shuffle_ps(t0_, t2_, 0x44);                         \
@@ -107,9 +99,9 @@ static POSE__INLINE void store_lanes(float *restrict out, size_t b, size_t count
 #else
 #define LOAD_XYZ(tp, idx, X, Y, Z)                                                  \
     do {                                                                            \
-        (X) = V8_GATHER(tp, idx, 0);                                                \
-        (Y) = V8_GATHER(tp, idx, 1);                                                \
-        (Z) = V8_GATHER(tp, idx, 2);                                                \
+        (X) = V8_GATHER(tp, idx, 3, 0);                                             \
+        (Y) = V8_GATHER(tp, idx, 3, 1);                                             \
+        (Z) = V8_GATHER(tp, idx, 3, 2);                                             \
     } while (0)
 #endif
 
@@ -124,15 +116,14 @@ void POSE__KV(pose__skin_blocks)(int method, const pose__skin_mesh *m,
         const pose__v8f vy = *(const pose__v8f *)(rb + 8);
         const pose__v8f vz = *(const pose__v8f *)(rb + 16);
         const unsigned kb = m->active[b];
-        int32_t idx[8];
-        joint_offsets(m, b, 0, idx);
-        pose__v8f q0x = V8_GATHER(pf, idx, 0), q0y = V8_GATHER(pf, idx, 1);
-        pose__v8f q0z = V8_GATHER(pf, idx, 2), q0w = V8_GATHER(pf, idx, 3);
+        const uint16_t *idx = joint_row(m, b, 0);
+        pose__v8f q0x = PAL(idx, 0), q0y = PAL(idx, 1);
+        pose__v8f q0z = PAL(idx, 2), q0w = PAL(idx, 3);
         pose__v8f ox, oy, oz, rx, ry, rz;
         if (kb == 1) {
             /* every lane bound to one joint: rigid, the same for all methods */
-            pose__v8f tx = V8_GATHER(pf, idx, 4), ty = V8_GATHER(pf, idx, 5);
-            pose__v8f tz = V8_GATHER(pf, idx, 6);
+            pose__v8f tx = PAL(idx, 4), ty = PAL(idx, 5);
+            pose__v8f tz = PAL(idx, 6);
             V8_ROTDISP(rx, ry, rz, q0x, q0y, q0z, q0w, vx, vy, vz);
             ox = vx + (rx + tx);
             oy = vy + (ry + ty);
@@ -141,13 +132,12 @@ void POSE__KV(pose__skin_blocks)(int method, const pose__skin_mesh *m,
             /* v' = v + sum w (R v - v + t) */
             pose__v8f dx = V8_SPLAT(0.0f), dy = dx, dz = dx;
             for (unsigned k = 0; k < kb; k++) {
-                if (k > 0)
-                    joint_offsets(m, b, k, idx);
+                idx = joint_row(m, b, k);
                 pose__v8f w = block_weights(m, b, k);
-                pose__v8f qx = V8_GATHER(pf, idx, 0), qy = V8_GATHER(pf, idx, 1);
-                pose__v8f qz = V8_GATHER(pf, idx, 2), qw = V8_GATHER(pf, idx, 3);
-                pose__v8f tx = V8_GATHER(pf, idx, 4), ty = V8_GATHER(pf, idx, 5);
-                pose__v8f tz = V8_GATHER(pf, idx, 6);
+                pose__v8f qx = PAL(idx, 0), qy = PAL(idx, 1);
+                pose__v8f qz = PAL(idx, 2), qw = PAL(idx, 3);
+                pose__v8f tx = PAL(idx, 4), ty = PAL(idx, 5);
+                pose__v8f tz = PAL(idx, 6);
                 V8_ROTDISP(rx, ry, rz, qx, qy, qz, qw, vx, vy, vz);
                 dx += w * (rx + tx);
                 dy += w * (ry + ty);
@@ -161,17 +151,16 @@ void POSE__KV(pose__skin_blocks)(int method, const pose__skin_mesh *m,
             pose__v8f bx = V8_SPLAT(0.0f), by = bx, bz = bx, bw = bx;
             pose__v8f ex = bx, ey = bx, ez = bx, ew = bx;
             for (unsigned k = 0; k < kb; k++) {
-                if (k > 0)
-                    joint_offsets(m, b, k, idx);
-                pose__v8f qx = V8_GATHER(pf, idx, 0), qy = V8_GATHER(pf, idx, 1);
-                pose__v8f qz = V8_GATHER(pf, idx, 2), qw = V8_GATHER(pf, idx, 3);
+                idx = joint_row(m, b, k);
+                pose__v8f qx = PAL(idx, 0), qy = PAL(idx, 1);
+                pose__v8f qz = PAL(idx, 2), qw = PAL(idx, 3);
                 pose__v8f dot = qx * q0x + qy * q0y + qz * q0z + qw * q0w;
                 pose__v8f w = V8_NEG_WHERE(block_weights(m, b, k), dot);
                 bx += w * qx; by += w * qy; bz += w * qz; bw += w * qw;
-                ex += w * V8_GATHER(pf, idx, 8);
-                ey += w * V8_GATHER(pf, idx, 9);
-                ez += w * V8_GATHER(pf, idx, 10);
-                ew += w * V8_GATHER(pf, idx, 11);
+                ex += w * PAL(idx, 8);
+                ey += w * PAL(idx, 9);
+                ez += w * PAL(idx, 10);
+                ew += w * PAL(idx, 11);
             }
             pose__v8f inv = 1.0f / V8_SQRT(bx * bx + by * by + bz * bz + bw * bw);
             bx *= inv; by *= inv; bz *= inv; bw *= inv;
@@ -194,18 +183,17 @@ void POSE__KV(pose__skin_blocks)(int method, const pose__skin_mesh *m,
             pose__v8f bx = V8_SPLAT(0.0f), by = bx, bz = bx, bw = bx;
             pose__v8f dx = bx, dy = bx, dz = bx;
             for (unsigned k = 0; k < kb; k++) {
-                if (k > 0)
-                    joint_offsets(m, b, k, idx);
+                idx = joint_row(m, b, k);
                 pose__v8f w = block_weights(m, b, k);
-                pose__v8f qx = V8_GATHER(pf, idx, 0), qy = V8_GATHER(pf, idx, 1);
-                pose__v8f qz = V8_GATHER(pf, idx, 2), qw = V8_GATHER(pf, idx, 3);
+                pose__v8f qx = PAL(idx, 0), qy = PAL(idx, 1);
+                pose__v8f qz = PAL(idx, 2), qw = PAL(idx, 3);
                 pose__v8f dot = qx * q0x + qy * q0y + qz * q0z + qw * q0w;
                 pose__v8f ws = V8_NEG_WHERE(w, dot);
                 bx += ws * qx; by += ws * qy; bz += ws * qz; bw += ws * qw;
                 V8_ROTDISP(rx, ry, rz, qx, qy, qz, qw, cx, cy, cz);
-                dx += w * (rx + V8_GATHER(pf, idx, 4));
-                dy += w * (ry + V8_GATHER(pf, idx, 5));
-                dz += w * (rz + V8_GATHER(pf, idx, 6));
+                dx += w * (rx + PAL(idx, 4));
+                dy += w * (ry + PAL(idx, 5));
+                dz += w * (rz + PAL(idx, 6));
             }
             pose__v8f inv = 1.0f / V8_SQRT(bx * bx + by * by + bz * bz + bw * bw);
             bx *= inv; by *= inv; bz *= inv; bw *= inv;
@@ -219,24 +207,39 @@ void POSE__KV(pose__skin_blocks)(int method, const pose__skin_mesh *m,
     }
 }
 
+/* Normalize the raw normals of blocks [b0, b0 + n) and store them. Kept
+ * apart from the gathers: a short, independent loop the core can overlap,
+ * instead of a sqrt + divide at the end of a long dependency chain. */
+static POSE__INLINE void store_normals(const pose__transfer_mesh *m, const pose__v8f (*raw)[3],
+                                       size_t b0, size_t n, float *restrict nrm)
+{
+    for (size_t i = 0; i < n; i++) {
+        pose__v8f nx = raw[i][0], ny = raw[i][1], nz = raw[i][2];
+        pose__v8f n2 = nx * nx + ny * ny + nz * nz;
+        /* a flattened tet or a vertex without triangles has no normal: 0 */
+        pose__v8f s = V8_AND_MASK(1.0f / V8_SQRT(n2), n2 > 1e-36f);
+        nx *= s;
+        ny *= s;
+        nz *= s;
+        store_lanes(nrm, b0 + i, m->vertex_count, &nx, &ny, &nz, 1);
+    }
+}
+
+#define TRANSFER_BATCH 16 /* blocks whose raw normals wait in L1 */
+
 void POSE__KV(pose__transfer_blocks)(const pose__transfer_mesh *m, const float *restrict tp,
                                      size_t begin, size_t end, float *restrict pos,
                                      float *restrict nrm)
 {
+    pose__v8f raw[TRANSFER_BATCH][3];
+    size_t batch_start = begin;
     for (size_t b = begin; b < end; b++) {
         const uint32_t *tv = m->tet_vertices + 4 * POSE__BLOCK * b;
-        int32_t i0[8], i1[8], i2[8], i3[8];
-        for (int l = 0; l < 8; l++) {
-            i0[l] = (int32_t)(3 * tv[l]);
-            i1[l] = (int32_t)(3 * tv[8 + l]);
-            i2[l] = (int32_t)(3 * tv[16 + l]);
-            i3[l] = (int32_t)(3 * tv[24 + l]);
-        }
         pose__v8f v0x, v0y, v0z, e1x, e1y, e1z, e2x, e2y, e2z, e3x, e3y, e3z;
-        LOAD_XYZ(tp, i0, v0x, v0y, v0z);
-        LOAD_XYZ(tp, i1, e1x, e1y, e1z);
-        LOAD_XYZ(tp, i2, e2x, e2y, e2z);
-        LOAD_XYZ(tp, i3, e3x, e3y, e3z);
+        LOAD_XYZ(tp, tv, v0x, v0y, v0z);
+        LOAD_XYZ(tp, tv + 8, e1x, e1y, e1z);
+        LOAD_XYZ(tp, tv + 16, e2x, e2y, e2z);
+        LOAD_XYZ(tp, tv + 24, e3x, e3y, e3z);
         e1x -= v0x; e1y -= v0y; e1z -= v0z;
         e2x -= v0x; e2y -= v0y; e2z -= v0z;
         e3x -= v0x; e3y -= v0y; e3z -= v0z;
@@ -254,19 +257,17 @@ void POSE__KV(pose__transfer_blocks)(const pose__transfer_mesh *m, const float *
         const pose__v8f k2 = __builtin_convertvector(*(const pose__v8i16 *)(kb + 8), pose__v8f);
         const pose__v8f k3 = __builtin_convertvector(*(const pose__v8i16 *)(kb + 16), pose__v8f);
         /* cof(D') k = k1 (e2 x e3) + k2 (e3 x e1) + k3 (e1 x e2) */
-        pose__v8f nx = k1 * (e2y * e3z - e2z * e3y) + k2 * (e3y * e1z - e3z * e1y) +
-                       k3 * (e1y * e2z - e1z * e2y);
-        pose__v8f ny = k1 * (e2z * e3x - e2x * e3z) + k2 * (e3z * e1x - e3x * e1z) +
-                       k3 * (e1z * e2x - e1x * e2z);
-        pose__v8f nz = k1 * (e2x * e3y - e2y * e3x) + k2 * (e3x * e1y - e3y * e1x) +
-                       k3 * (e1x * e2y - e1y * e2x);
-        pose__v8f n2 = nx * nx + ny * ny + nz * nz;
-        /* a flattened tet or a vertex without triangles has no normal: 0 */
-        pose__v8f s = V8_AND_MASK(1.0f / V8_SQRT(n2), n2 > 1e-36f);
-        nx *= s;
-        ny *= s;
-        nz *= s;
-        store_lanes(nrm, b, m->vertex_count, &nx, &ny, &nz, 1);
+        pose__v8f *r = raw[b - batch_start];
+        r[0] = k1 * (e2y * e3z - e2z * e3y) + k2 * (e3y * e1z - e3z * e1y) +
+               k3 * (e1y * e2z - e1z * e2y);
+        r[1] = k1 * (e2z * e3x - e2x * e3z) + k2 * (e3z * e1x - e3x * e1z) +
+               k3 * (e1z * e2x - e1x * e2z);
+        r[2] = k1 * (e2x * e3y - e2y * e3x) + k2 * (e3x * e1y - e3y * e1x) +
+               k3 * (e1x * e2y - e1y * e2x);
+        if (b + 1 - batch_start == TRANSFER_BATCH || b + 1 == end) {
+            store_normals(m, (const pose__v8f(*)[3])raw, batch_start, b + 1 - batch_start, nrm);
+            batch_start = b + 1;
+        }
     }
 #ifdef __AVX2__
     _mm_sfence(); /* order the streaming stores before the pool's hand-back */

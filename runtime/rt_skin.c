@@ -59,12 +59,11 @@ void pose__skin(int method, const pose__skin_mesh *mesh, const pose__skin_joint 
 
 size_t pose__skin_bytes(int method, const pose__skin_mesh *m)
 {
-    const size_t jsize = m->joints8 ? 1 : 2;
     size_t bytes = 0;
     for (size_t b = 0; b < m->block_count; b++) {
         size_t kb = m->active[b];
         bytes += 1 + 3 * POSE__BLOCK * 4 /* rest */ + 3 * POSE__BLOCK * 4 /* out */;
-        bytes += kb * POSE__BLOCK * jsize;
+        bytes += kb * POSE__BLOCK * 2; /* joints */
         if (kb > 1) {
             bytes += kb * POSE__BLOCK * 2; /* weights */
             if (method == POSE__SKIN_COR)

@@ -45,8 +45,7 @@ typedef struct pose__skin_mesh {
     const float *rest;        /**< block_count * 24: x[8] y[8] z[8] per block */
     const float *cor;         /**< same layout, or NULL */
     const uint8_t *active;    /**< block_count: influences used by some lane (1..K) */
-    const uint8_t *joints8;   /**< block_count * K * 8 joint indices, [block][k][lane] ... */
-    const uint16_t *joints16; /**< ... or these for rigs with > 256 joints */
+    const uint16_t *joints;   /**< block_count * K * 8 joint indices, [block][k][lane] */
     const uint16_t *weights;  /**< block_count * K * 8, largest first, sum POSE__WEIGHT_ONE */
 } pose__skin_mesh;
 

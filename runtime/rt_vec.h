@@ -20,12 +20,18 @@ typedef int16_t pose__v8i16 __attribute__((vector_size(16)));
 typedef uint8_t pose__v8u8 __attribute__((vector_size(8)));
 
 #define V8_SPLAT(x) ((pose__v8f){(x), (x), (x), (x), (x), (x), (x), (x)})
-/* Lane l takes base[idx[l] + off]. */
-#define V8_GATHER(base, idx, off)                                                   \
-    ((pose__v8f){(base)[(idx)[0] + (off)], (base)[(idx)[1] + (off)],                \
-                 (base)[(idx)[2] + (off)], (base)[(idx)[3] + (off)],                \
-                 (base)[(idx)[4] + (off)], (base)[(idx)[5] + (off)],                \
-                 (base)[(idx)[6] + (off)], (base)[(idx)[7] + (off)]})
+/* Lane l takes base[idx[l] * stride + off]; idx points at 8 unsigned
+ * indices in memory (read as scalars: address arithmetic stays in integer
+ * registers instead of being extracted from a vector). */
+#define V8_GATHER(base, idx, stride, off)                                           \
+    ((pose__v8f){(base)[(size_t)(idx)[0] * (stride) + (off)],                       \
+                 (base)[(size_t)(idx)[1] * (stride) + (off)],                       \
+                 (base)[(size_t)(idx)[2] * (stride) + (off)],                       \
+                 (base)[(size_t)(idx)[3] * (stride) + (off)],                       \
+                 (base)[(size_t)(idx)[4] * (stride) + (off)],                       \
+                 (base)[(size_t)(idx)[5] * (stride) + (off)],                       \
+                 (base)[(size_t)(idx)[6] * (stride) + (off)],                       \
+                 (base)[(size_t)(idx)[7] * (stride) + (off)]})
 /* Flip the sign of w in the lanes where neg < 0 (exactly -w). */
 #define V8_NEG_WHERE(w, neg)                                                        \
     ((pose__v8f)((pose__v8i)(w) ^ ((pose__v8i)((neg) < 0.0f) &                      \

@@ -116,7 +116,6 @@ pose_status pose__rig_prepare(pose_rig *rig)
     for (size_t t = 0; t < rig->tissue_count; t++)
         total += rig->tissues[t].vertex_count;
     const size_t tb = (total + B - 1) / B;
-    const int narrow = nj <= 256;
     /* The kernels index vertex coordinates with 32-bit offsets (3 * index). */
     if (nv > (size_t)INT32_MAX / 4)
         return pose__fail(POSE_ERR_UNSUPPORTED,
@@ -132,7 +131,7 @@ pose_status pose__rig_prepare(pose_rig *rig)
     const size_t off_active = off;
     off += align64(nb);
     const size_t off_joints = off;
-    off += align64(nb * K * B * (narrow ? 1 : 2));
+    off += align64(nb * K * B * sizeof(uint16_t));
     const size_t off_weights = off;
     off += align64(nb * K * B * 2);
     const size_t off_offsets = off;
@@ -160,8 +159,7 @@ pose_status pose__rig_prepare(pose_rig *rig)
     float *rest = (float *)(block + off_rest);
     float *cor = rig->cor ? (float *)(block + off_cor) : NULL;
     uint8_t *active = block + off_active;
-    uint8_t *j8 = narrow ? block + off_joints : NULL;
-    uint16_t *j16 = narrow ? NULL : (uint16_t *)(block + off_joints);
+    uint16_t *j16 = (uint16_t *)(block + off_joints);
     uint16_t *w16 = (uint16_t *)(block + off_weights);
     for (size_t b = 0; b < nb; b++) {
         unsigned used = 1;
@@ -177,10 +175,7 @@ pose_status pose__rig_prepare(pose_rig *rig)
                             joints, weights);
             for (size_t k = 0; k < K; k++) {
                 size_t at = (b * K + k) * B + l;
-                if (narrow)
-                    j8[at] = (uint8_t)joints[k];
-                else
-                    j16[at] = joints[k];
+                j16[at] = joints[k];
                 w16[at] = weights[k];
                 if (weights[k] != 0 && k + 1 > used)
                     used = (unsigned)k + 1;
@@ -190,7 +185,7 @@ pose_status pose__rig_prepare(pose_rig *rig)
     }
     rt->skin = (pose__skin_mesh){
         .vertex_count = nv, .block_count = nb, .influences = (unsigned)K, .rest = rest,
-        .cor = cor, .active = active, .joints8 = j8, .joints16 = j16, .weights = w16,
+        .cor = cor, .active = active, .joints = j16, .weights = w16,
     };
 
     /* ---- tissue vertices, all tissues one after another, same blocking */

@@ -20,7 +20,7 @@
 typedef struct packed_skin {
     pose__skin_mesh mesh;
     float *rest, *cor;
-    uint8_t *active, *j8;
+    uint8_t *active;
     uint16_t *j16, *w;
 } packed_skin;
 
@@ -33,14 +33,13 @@ static void *zalloc(size_t n)
 }
 
 static packed_skin pack_skin(size_t n, unsigned K, const float *rest, const float *cor,
-                             const uint16_t *joints, const uint16_t *weights, int wide)
+                             const uint16_t *joints, const uint16_t *weights)
 {
     packed_skin p;
     size_t nb = (n + 7) / 8;
     p.rest = zalloc(nb * 24 * sizeof(float));
     p.cor = zalloc(nb * 24 * sizeof(float));
     p.active = zalloc(nb);
-    p.j8 = zalloc(nb * K * 8);
     p.j16 = zalloc(nb * K * 8 * 2);
     p.w = zalloc(nb * K * 8 * 2);
     for (size_t b = 0; b < nb; b++) {
@@ -53,7 +52,6 @@ static packed_skin pack_skin(size_t n, unsigned K, const float *rest, const floa
             }
             for (unsigned k = 0; k < K; k++) {
                 size_t at = (b * K + k) * 8 + l;
-                p.j8[at] = (uint8_t)joints[src * K + k];
                 p.j16[at] = joints[src * K + k];
                 p.w[at] = weights[src * K + k];
                 if (weights[src * K + k] && k + 1 > p.active[b])
@@ -63,14 +61,13 @@ static packed_skin pack_skin(size_t n, unsigned K, const float *rest, const floa
     }
     p.mesh = (pose__skin_mesh){.vertex_count = n, .block_count = nb, .influences = K,
                                .rest = p.rest, .cor = p.cor, .active = p.active,
-                               .joints8 = wide ? NULL : p.j8, .joints16 = wide ? p.j16 : NULL,
-                               .weights = p.w};
+                               .joints = p.j16, .weights = p.w};
     return p;
 }
 
 static void free_skin(packed_skin *p)
 {
-    free(p->rest); free(p->cor); free(p->active); free(p->j8); free(p->j16); free(p->w);
+    free(p->rest); free(p->cor); free(p->active); free(p->j16); free(p->w);
 }
 
 typedef struct packed_transfer {
@@ -128,7 +125,7 @@ static void test_blend_antipodal_quaternions(void **unused)
     const float cor[6] = {0.5f, 0.5f, 0.5f, 0.0f, 1.0f, 0.0f};
     const uint16_t joints[4] = {0, 1, 1, 0};
     const uint16_t weights[4] = {16384, 16384, 16384, 16384};
-    packed_skin ps = pack_skin(2, 2, rest, cor, joints, weights, 0);
+    packed_skin ps = pack_skin(2, 2, rest, cor, joints, weights);
     for (int method = POSE__SKIN_DQS; method <= POSE__SKIN_COR; method++) {
         float out[6];
         pose__skin(method, &ps.mesh, pal, 0, 1, out);
@@ -142,8 +139,7 @@ static void test_blend_antipodal_quaternions(void **unused)
     free_skin(&ps);
 }
 
-/* LBS, DQS and CoR agree for a vertex bound to one joint (rigid), and the
- * 16-bit joint index path matches the 8-bit one. */
+/* LBS, DQS and CoR agree for a vertex bound to one joint (rigid). */
 static void test_single_joint_rigid_all_methods(void **unused)
 {
     (void)unused;
@@ -162,19 +158,16 @@ static void test_single_joint_rigid_all_methods(void **unused)
     const float rest[3] = {0.7f, -1.1f, 2.5f}, cor[3] = {9.0f, 9.0f, 9.0f};
     const uint16_t j16[3] = {2, 0, 1};
     const uint16_t w[3] = {32768, 0, 0};
-    packed_skin p8 = pack_skin(1, 3, rest, cor, j16, w, 0), p16 = pack_skin(1, 3, rest, cor, j16, w, 1);
+    packed_skin p1 = pack_skin(1, 3, rest, cor, j16, w);
     double xq[4] = {x[2].q[0], x[2].q[1], x[2].q[2], x[2].q[3]}, p[3] = {rest[0], rest[1], rest[2]}, e[3];
     dq_rot(e, xq, p);
     for (int method = 0; method < 3; method++) {
-        float a[3], b[3];
-        pose__skin(method, &p8.mesh, pal, 0, 1, a);
-        pose__skin(method, &p16.mesh, pal, 0, 1, b);
-        assert_memory_equal(a, b, sizeof a);
+        float a[3];
+        pose__skin(method, &p1.mesh, pal, 0, 1, a);
         for (int k = 0; k < 3; k++)
             assert_near(a[k], e[k] + x[2].t[k], 1e-5);
     }
-    free_skin(&p8);
-    free_skin(&p16);
+    free_skin(&p1);
 }
 
 /* Under an affine map of the tet vertices, barycentric transfer reproduces
@@ -300,7 +293,7 @@ static void test_variants_identical(void **unused)
     }
     pose__skin_joint pal[NJ];
     pose__skin_palette(NJ, x, pal);
-    packed_skin ps = pack_skin(NV, K, rest, cor, joints, weights, 0);
+    packed_skin ps = pack_skin(NV, K, rest, cor, joints, weights);
     uint32_t tv[4 * NT];
     float bary[3 * NT];
     int16_t key[3 * NT];
