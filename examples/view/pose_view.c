@@ -42,7 +42,8 @@ static void usage(FILE *f)
           "  --size WxH              window size (default 1280x800)\n"
           "  --quit-after N          close after N frames and print the frame rate (smoke tests)\n"
           "  -h, --help              this text\n"
-          "Keys: mouse drag orbit, right drag pan, wheel zoom | 1 LBS 2 DQS 3 CoR | S skin\n"
+          "Mouse: drag orbit, right drag pan, wheel zoom, ctrl+click pick a joint, shift+drag rotate it\n"
+          "Keys: 1 LBS 2 DQS 3 CoR | S skin\n"
           "  (translucent/opaque/hidden) B bones M muscles O organs T other | W weights of the\n"
           "  selected joint | [ ] select joint | X/Y/Z rotate +5 deg (Shift: -5) | R reset |\n"
           "  J joints | Space play/pause . step , back Home start Left/Right seek 1 s | F frame all |\n"
@@ -178,16 +179,59 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     }
 }
 
+/* The joint whose centre is drawn nearest to window point (x, y), within 25 pixels, or -1. */
+static int pick_joint(viewer *v, GLFWwindow *w, double x, double y)
+{
+    int ww, wh, fw, fh, best = -1;
+    float view[16], proj[16], best_d2 = 25.0f * 25.0f;
+    glfwGetWindowSize(w, &ww, &wh);
+    glfwGetFramebufferSize(w, &fw, &fh);
+    if (ww <= 0 || wh <= 0 || fh <= 0)
+        return -1;
+    ex_camera_view(&v->cam, view);
+    ex_camera_projection(&v->cam, (float)fw / (float)fh, proj);
+    for (size_t j = 0; j < pose_rig_joint_count(v->sc.rig); j++) {
+        pose_transform xf;
+        if (pose_joint_world(v->sc.state, (int)j, &xf) < 0)
+            continue;
+        float e[4], c[4];
+        for (int r = 0; r < 4; r++) /* eye space, then clip space (column-major matrices) */
+            e[r] = view[r] * xf.translation[0] + view[4 + r] * xf.translation[1] + view[8 + r] * xf.translation[2] +
+                   view[12 + r];
+        for (int r = 0; r < 4; r++)
+            c[r] = proj[r] * e[0] + proj[4 + r] * e[1] + proj[8 + r] * e[2] + proj[12 + r] * e[3];
+        if (c[3] <= 0.0f)
+            continue;
+        float sx = (c[0] / c[3] * 0.5f + 0.5f) * (float)ww, sy = (0.5f - c[1] / c[3] * 0.5f) * (float)wh;
+        float d2 = (sx - (float)x) * (sx - (float)x) + (sy - (float)y) * (sy - (float)y);
+        if (d2 < best_d2) {
+            best_d2 = d2;
+            best = (int)j;
+        }
+    }
+    return best;
+}
+
 static void on_button(GLFWwindow *w, int button, int action, int mods)
 {
-    (void)mods;
     viewer *v = glfwGetWindowUserPointer(w);
-    if (action == GLFW_PRESS) {
-        v->dragging = button == GLFW_MOUSE_BUTTON_LEFT ? 1 : 2;
-        glfwGetCursorPos(w, &v->last_mouse[0], &v->last_mouse[1]);
-    } else {
+    if (action != GLFW_PRESS) {
         v->dragging = 0;
+        return;
     }
+    glfwGetCursorPos(w, &v->last_mouse[0], &v->last_mouse[1]);
+    if (button == GLFW_MOUSE_BUTTON_LEFT && (mods & GLFW_MOD_CONTROL)) {
+        int j = pick_joint(v, w, v->last_mouse[0], v->last_mouse[1]);
+        char name[64];
+        if (j >= 0) {
+            v->joint = j;
+            v->show_joints = 1;
+            joint_name(v, name, sizeof name);
+            snprintf(v->status, sizeof v->status, "selected %s (shift+drag rotates it)", name);
+        }
+        return;
+    }
+    v->dragging = button != GLFW_MOUSE_BUTTON_LEFT ? 2 : (mods & GLFW_MOD_SHIFT) ? 3 : 1;
 }
 
 static void on_cursor(GLFWwindow *w, double x, double y)
@@ -205,6 +249,12 @@ static void on_cursor(GLFWwindow *w, double x, double y)
             v->cam.elevation_deg = -89.0f;
     } else if (v->dragging == 2) {
         ex_camera_pan(&v->cam, -(float)dx * 0.0015f, (float)dy * 0.0015f);
+    } else if (v->dragging == 3) {
+        /* Vertical drag: the joint's local y (flexion of the template's hinges), horizontal: local z. */
+        if (dy != 0.0)
+            rotate_selected(v, 1, (float)dy * 0.5f);
+        if (dx != 0.0)
+            rotate_selected(v, 2, (float)dx * 0.5f);
     }
 }
 
@@ -231,12 +281,13 @@ static void hud(viewer *v, int fw, int fh)
     if (v->show_help) {
         static const char *help[] = {
             "drag: orbit   right drag: pan   wheel: zoom   F: frame all",
+            "ctrl+click: pick a joint   shift+drag: rotate it (limits apply)",
             "1/2/3: LBS/DQS/CoR   S: skin   B/M/O/T: bones/muscles/organs/other",
             "[ ]: select joint   X/Y/Z: rotate +5 (shift -5)   R: reset   J: joints",
             "W: weights of joint   space: play   . , : step   left/right: seek 1 s",
             "H: hide this help   Esc: quit"};
-        for (int i = 0; i < 5; i++)
-            ex_draw_text(10, 56 + 18 * i, 2, dim, help[i], fw, fh);
+        for (size_t i = 0; i < sizeof help / sizeof help[0]; i++)
+            ex_draw_text(10, 56 + 18 * (int)i, 2, dim, help[i], fw, fh);
     }
 }
 
