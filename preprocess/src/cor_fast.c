@@ -134,317 +134,165 @@ int pp_cor_naive(const pp_tetmesh *m, const pp_weights *w, double sigma, float *
     return POSE_OK;
 }
 
-/* ---- clustering ---------------------------------------------------- */
+/* ---- pair bins ----------------------------------------------------- */
 
-/* Clusters in structure-of-arrays form with variable-length joint lists
- * (a few joints each), so millions of them stay compact. */
-typedef struct clusters {
-    size_t count;
-    uint32_t *off;   /* count + 1 into joints/weights */
-    uint16_t *joints;
-    double *weights; /* volume-weighted mean */
-    double *vol;     /* Σ V */
-    double *vc;      /* Σ V c, 3 per cluster */
-} clusters;
+/* Raw sums while binning, turned into evaluation form by finish_bins. */
+typedef struct bin_acc {
+    uint64_t key;
+    double v, vc[3], vb[2], vcb[2][3];
+} bin_acc;
 
-typedef struct keyed {
-    uint64_t hash;
-    uint32_t item;   /* tet or vertex */
-    uint32_t off;    /* into the key pool */
-    uint8_t n;
-} keyed;
+/* Evaluation form: mean weights of the pair's two joints, Σ V, Σ V c and
+ * the first moments Σ V c (b_k - mean_k). */
+typedef struct bin {
+    double b[2], v, vc[3], m[2][3];
+} bin;
 
-typedef struct key_pool {
-    uint16_t *j;
-    int32_t *q;
-} key_pool;
+#define MAX_JOINTS 1024u
+#define Q_BITS 20
 
-/* qsort has no context argument in C11: the pool travels thread-locally. */
-static _Thread_local const key_pool *g_sort_pool;
+typedef struct bin_table {
+    uint64_t *keys; /* open addressing, key + 1 (0 = empty) */
+    uint32_t *slot; /* bin index per occupied key */
+    size_t cap;
+    bin_acc *acc;
+    size_t count, acc_cap;
+} bin_table;
 
-static int cmp_keyed(const void *a, const void *b)
+static uint64_t mix64(uint64_t x)
 {
-    const keyed *x = a, *y = b;
-    if (x->hash != y->hash)
-        return x->hash < y->hash ? -1 : 1;
-    if (x->n != y->n)
-        return x->n < y->n ? -1 : 1;
-    int c = memcmp(g_sort_pool->j + x->off, g_sort_pool->j + y->off, x->n * sizeof(uint16_t));
-    if (c)
-        return c;
-    c = memcmp(g_sort_pool->q + x->off, g_sort_pool->q + y->off, x->n * sizeof(int32_t));
-    if (c)
-        return c;
-    return x->item < y->item ? -1 : x->item > y->item;
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdull;
+    x ^= x >> 33;
+    x *= 0xc4ceb3f99c6b32e3ull;
+    return x ^ (x >> 33);
 }
 
-static int same_key(const key_pool *p, const keyed *x, const keyed *y)
+static int table_grow(bin_table *t)
 {
-    return x->hash == y->hash && x->n == y->n &&
-           !memcmp(p->j + x->off, p->j + y->off, x->n * sizeof(uint16_t)) &&
-           !memcmp(p->q + x->off, p->q + y->off, x->n * sizeof(int32_t));
-}
-
-static void make_key(const sparse_w *s, double inv_tol, key_pool *pool, keyed *k, uint32_t item,
-                     uint32_t off)
-{
-    uint64_t h = 1469598103934665603ull;
-    for (int i = 0; i < s->n; i++) {
-        int32_t q = inv_tol > 0 ? (int32_t)lrint(s->w[i] * inv_tol) : (int32_t)item;
-        pool->j[off + i] = s->j[i];
-        pool->q[off + i] = q;
-        h = (h ^ s->j[i]) * 1099511628211ull;
-        h = (h ^ (uint32_t)q) * 1099511628211ull;
+    size_t cap = t->cap ? 2 * t->cap : 1u << 16;
+    uint64_t *keys = calloc(cap, sizeof *keys);
+    uint32_t *slot = malloc(cap * sizeof *slot);
+    if (!keys || !slot) {
+        free(keys), free(slot);
+        return -1;
     }
-    *k = (keyed){h, item, off, (uint8_t)s->n};
+    for (size_t i = 0; i < t->cap; i++)
+        if (t->keys[i]) {
+            size_t h = mix64(t->keys[i]) & (cap - 1);
+            while (keys[h])
+                h = (h + 1) & (cap - 1);
+            keys[h] = t->keys[i];
+            slot[h] = t->slot[i];
+        }
+    free(t->keys);
+    free(t->slot);
+    t->keys = keys;
+    t->slot = slot;
+    t->cap = cap;
+    return 0;
 }
 
-typedef struct pair_entry {
-    uint32_t pair; /* i * joints + j, i < j */
-    uint32_t cluster;
-} pair_entry;
-
-static int cmp_pair(const void *a, const void *b)
+/* The accumulator for key (created zeroed), or NULL when out of memory. */
+static bin_acc *table_get(bin_table *t, uint64_t key)
 {
-    const pair_entry *x = a, *y = b;
-    if (x->pair != y->pair)
-        return x->pair < y->pair ? -1 : 1;
-    return x->cluster < y->cluster ? -1 : x->cluster > y->cluster;
+    if (2 * (t->count + 1) > t->cap && table_grow(t) < 0)
+        return NULL;
+    size_t h = mix64(key + 1) & (t->cap - 1);
+    while (t->keys[h]) {
+        if (t->keys[h] == key + 1)
+            return &t->acc[t->slot[h]];
+        h = (h + 1) & (t->cap - 1);
+    }
+    if (t->count == t->acc_cap) {
+        size_t c = t->acc_cap ? 2 * t->acc_cap : 1u << 14;
+        bin_acc *a = realloc(t->acc, c * sizeof *a);
+        if (!a)
+            return NULL;
+        t->acc = a;
+        t->acc_cap = c;
+    }
+    t->keys[h] = key + 1;
+    t->slot[h] = (uint32_t)t->count;
+    bin_acc *a = &t->acc[t->count++];
+    memset(a, 0, sizeof *a);
+    a->key = key;
+    return a;
 }
+
+static int cmp_acc(const void *x, const void *y)
+{
+    uint64_t a = ((const bin_acc *)x)->key, b = ((const bin_acc *)y)->key;
+    return a < b ? -1 : a > b;
+}
+
+/* Per (pair, vertex-weight cell) results: num[3], den, and their
+ * derivatives along a_i and a_j (num_i[3], den_i, num_j[3], den_j). */
+enum { CELL_RESULT = 12 };
 
 typedef struct cor_ctx {
-    const pp_tetmesh *mesh;
-    const pp_weights *w;
-    const clusters *cl;
-    const pair_entry *pairs;
-    size_t pair_count;
-    uint32_t joints;
+    const uint32_t *pair_start; /* bins of pair p: [pair_start[p], pair_start[p + 1]) */
+    const bin *bins;
+    const bin_acc *cells;       /* key (pair in the top bits), Σ a_i, Σ a_j, count in v */
+    double *result;             /* CELL_RESULT per cell */
     double inv_sigma2;
-    const uint32_t *eval_vertex; /* representative vertex per evaluation */
-    double *eval_cor;            /* 3 per evaluation */
-    size_t eval_count;
 } cor_ctx;
 
 typedef struct cor_job {
     const cor_ctx *ctx;
     size_t begin, end;
-    uint32_t *stamp; /* per thread, one per cluster: visit each cluster once per vertex */
+    size_t evaluations;
 } cor_job;
 
-static size_t lower_pair(const pair_entry *p, size_t n, uint32_t key)
-{
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        size_t mid = (lo + hi) / 2;
-        if (p[mid].pair < key)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
-}
-
+/* Evaluate each cell's pair sums at its mean (a_i, a_j), with the
+ * derivatives a vertex needs to correct for its own offset from the mean. */
 static void *cor_run(void *arg)
 {
     cor_job *job = arg;
     const cor_ctx *c = job->ctx;
-    uint32_t *stamp = job->stamp;
-    for (size_t e = job->begin; e < job->end; e++) {
-        uint32_t v = c->eval_vertex[e];
-        sparse_w wp;
-        vertex_weights(c->w, v, &wp);
-        double num[3] = {0}, den = 0;
-        uint32_t mark = (uint32_t)(e - job->begin) + 1;
-        for (int a = 0; a < wp.n; a++)
-            for (int b = a + 1; b < wp.n; b++) {
-                uint32_t key = (uint32_t)wp.j[a] * c->joints + wp.j[b];
-                for (size_t i = lower_pair(c->pairs, c->pair_count, key);
-                     i < c->pair_count && c->pairs[i].pair == key; i++) {
-                    uint32_t k = c->pairs[i].cluster;
-                    if (stamp[k] == mark)
-                        continue; /* shares another pair with this vertex: done */
-                    stamp[k] = mark;
-                    uint32_t o = c->cl->off[k], n = c->cl->off[k + 1] - o;
-                    double s = similarity(wp.j, wp.w, wp.n, c->cl->joints + o, c->cl->weights + o,
-                                          (int)n, c->inv_sigma2);
-                    den += s * c->cl->vol[k];
-                    for (int q = 0; q < 3; q++)
-                        num[q] += s * c->cl->vc[3 * (size_t)k + q];
-                }
+    const double k2 = 2 * c->inv_sigma2;
+    for (size_t k = job->begin; k < job->end; k++) {
+        const bin_acc *cell = &c->cells[k];
+        const double ai = cell->vb[0] / cell->v, aj = cell->vb[1] / cell->v, aa = ai * aj;
+        uint64_t p = cell->key >> 40;
+        const bin *b = c->bins + c->pair_start[p], *e = c->bins + c->pair_start[p + 1];
+        double r[CELL_RESULT] = {0};
+        job->evaluations += (size_t)(e - b);
+        for (; b < e; b++) {
+            const double bi = b->b[0], bj = b->b[1], bb = bi * bj;
+            const double d = ai * bj - bi * aj;
+            const double x = exp(-d * d * c->inv_sigma2);
+            const double E = aa * x, f = E * bb;
+            /* ∂f/∂b (first-order bin moments) and ∂f/∂a (vertex offsets). */
+            const double gi = E * (bj + k2 * bb * aj * d), gj = E * (bi - k2 * bb * ai * d);
+            const double fi = bb * aj * x * (1 - k2 * ai * d * bj);
+            const double fj = bb * ai * x * (1 + k2 * aj * d * bi);
+            for (int q = 0; q < 3; q++) {
+                r[q] += f * b->vc[q] + gi * b->m[0][q] + gj * b->m[1][q];
+                r[4 + q] += fi * b->vc[q];
+                r[8 + q] += fj * b->vc[q];
             }
-        for (int q = 0; q < 3; q++)
-            c->eval_cor[3 * e + q] =
-                den > 0 ? num[q] / den : (double)c->mesh->positions[3 * (size_t)v + q];
+            r[3] += f * b->v;
+            r[7] += fi * b->v;
+            r[11] += fj * b->v;
+        }
+        memcpy(c->result + CELL_RESULT * k, r, sizeof r);
     }
     return NULL;
 }
 
-static void clusters_free(clusters *c)
+static int run_jobs(cor_ctx *ctx, size_t count, int threads, size_t *evaluations)
 {
-    free(c->off);
-    free(c->joints);
-    free(c->weights);
-    free(c->vol);
-    free(c->vc);
-    memset(c, 0, sizeof *c);
-}
-
-int pp_cor_compute(const pp_tetmesh *m, const pp_weights *w, const pp_cor_options *opt,
-                   float *cor, pp_cor_report *rep_out, char *err, size_t err_size)
-{
-    struct timespec t0, t1;
-    clock_gettime(CLOCK_MONOTONIC, &t0);
-    pp_cor_report rep;
-    memset(&rep, 0, sizeof rep);
-    double sigma = opt && opt->sigma > 0 ? opt->sigma : 0.1;
-    double tol = opt && opt->tolerance != 0 ? opt->tolerance : 1e-4;
-    double inv_tol = tol > 0 ? 1.0 / tol : 0;
-    int threads = opt && opt->threads > 1 ? opt->threads : 1;
-    size_t n = m->vertex_count, nt = m->tet_count;
-    uint32_t joints = 0;
-    for (size_t i = 0; i < n * w->influences; i++)
-        joints = w->joints[i] + 1u > joints ? w->joints[i] + 1u : joints;
-    if (w->vertex_count != n || n > UINT32_MAX || nt > UINT32_MAX) {
-        snprintf(err, err_size, "cor: weights for %zu vertices, mesh has %zu", w->vertex_count, n);
-        return POSE_ERR_INVALID_ARGUMENT;
-    }
-    int rc = POSE_OK;
-    clusters cl = {0};
-    keyed *keys = NULL, *vkeys = NULL;
-    key_pool pool = {0}, vpool = {0};
-    pair_entry *pairs = NULL;
-    uint32_t *eval_vertex = NULL, *vertex_eval = NULL, *stamps = NULL;
-    double *eval_cor = NULL;
-    size_t maxs = 4 * (size_t)w->influences;
-
-    /* 1. Tets with >= 2 joints, keyed by joint set and quantized weights. */
-    keys = malloc((nt ? nt : 1) * sizeof *keys);
-    pool.j = malloc((nt * maxs + 1) * sizeof *pool.j);
-    pool.q = malloc((nt * maxs + 1) * sizeof *pool.q);
-    if (!keys || !pool.j || !pool.q)
-        goto oom;
-    size_t used = 0, poff = 0;
-    for (size_t t = 0; t < nt; t++) {
-        sparse_w s;
-        tet_mean_weights(m, w, t, &s);
-        if (s.n < 2)
-            continue;
-        make_key(&s, inv_tol, &pool, &keys[used++], (uint32_t)t, (uint32_t)poff);
-        poff += (size_t)s.n;
-    }
-    rep.tets_used = used;
-    g_sort_pool = &pool;
-    qsort(keys, used, sizeof *keys, cmp_keyed);
-    size_t ncl = 0;
-    for (size_t i = 0; i < used; i++)
-        ncl += i == 0 || !same_key(&pool, &keys[i - 1], &keys[i]);
-    cl.count = ncl;
-    cl.off = malloc((ncl + 1) * sizeof *cl.off);
-    cl.joints = malloc((poff + 1) * sizeof *cl.joints);
-    cl.weights = calloc(poff + 1, sizeof *cl.weights);
-    cl.vol = calloc(ncl + 1, sizeof *cl.vol);
-    cl.vc = calloc(3 * ncl + 1, sizeof *cl.vc);
-    if (!cl.off || !cl.joints || !cl.weights || !cl.vol || !cl.vc)
-        goto oom;
-    size_t k = (size_t)-1, coff = 0;
-    for (size_t i = 0; i < used; i++) {
-        if (i == 0 || !same_key(&pool, &keys[i - 1], &keys[i])) {
-            k++;
-            cl.off[k] = (uint32_t)coff;
-            memcpy(cl.joints + coff, pool.j + keys[i].off, keys[i].n * sizeof *cl.joints);
-            coff += keys[i].n;
-        }
-        sparse_w s;
-        tet_mean_weights(m, w, keys[i].item, &s);
-        double c[3], vol = tet_volume_centroid(m, keys[i].item, c);
-        cl.vol[k] += vol;
-        for (int q = 0; q < 3; q++)
-            cl.vc[3 * k + q] += vol * c[q];
-        for (int q = 0; q < s.n; q++)
-            cl.weights[cl.off[k] + (size_t)q] += vol * s.w[q];
-    }
-    cl.off[ncl] = (uint32_t)coff;
-    for (size_t c = 0; c < ncl; c++)
-        for (uint32_t q = cl.off[c]; q < cl.off[c + 1]; q++)
-            cl.weights[q] = cl.vol[c] > 0 ? cl.weights[q] / cl.vol[c] : 0;
-    rep.clusters = ncl;
-    free(keys);
-    keys = NULL;
-    free(pool.j);
-    free(pool.q);
-    pool.j = NULL;
-    pool.q = NULL;
-
-    /* 2. Joint-pair lists of clusters. */
-    size_t npairs = 0;
-    for (size_t c = 0; c < ncl; c++) {
-        size_t s = cl.off[c + 1] - cl.off[c];
-        npairs += s * (s - 1) / 2;
-    }
-    pairs = malloc((npairs ? npairs : 1) * sizeof *pairs);
-    if (!pairs)
-        goto oom;
-    size_t pi = 0;
-    for (size_t c = 0; c < ncl; c++)
-        for (uint32_t a = cl.off[c]; a < cl.off[c + 1]; a++)
-            for (uint32_t b = a + 1; b < cl.off[c + 1]; b++)
-                pairs[pi++] = (pair_entry){(uint32_t)cl.joints[a] * joints + cl.joints[b],
-                                           (uint32_t)c};
-    qsort(pairs, npairs, sizeof *pairs, cmp_pair);
-
-    /* 3. Vertices with >= 2 joints; equal quantized weights share one evaluation. */
-    vkeys = malloc((n ? n : 1) * sizeof *vkeys);
-    vpool.j = malloc((n * w->influences + 1) * sizeof *vpool.j);
-    vpool.q = malloc((n * w->influences + 1) * sizeof *vpool.q);
-    vertex_eval = malloc((n ? n : 1) * sizeof *vertex_eval);
-    if (!vkeys || !vpool.j || !vpool.q || !vertex_eval)
-        goto oom;
-    size_t nv = 0;
-    poff = 0;
-    for (size_t v = 0; v < n; v++) {
-        sparse_w s;
-        vertex_weights(w, v, &s);
-        vertex_eval[v] = UINT32_MAX;
-        if (s.n < 2)
-            continue;
-        make_key(&s, inv_tol, &vpool, &vkeys[nv++], (uint32_t)v, (uint32_t)poff);
-        poff += (size_t)s.n;
-    }
-    rep.vertices_with_cor = nv;
-    g_sort_pool = &vpool;
-    qsort(vkeys, nv, sizeof *vkeys, cmp_keyed);
-    size_t ne = 0;
-    for (size_t i = 0; i < nv; i++)
-        ne += i == 0 || !same_key(&vpool, &vkeys[i - 1], &vkeys[i]);
-    eval_vertex = malloc((ne ? ne : 1) * sizeof *eval_vertex);
-    eval_cor = malloc((3 * ne + 1) * sizeof *eval_cor);
-    if (!eval_vertex || !eval_cor)
-        goto oom;
-    size_t e = (size_t)-1;
-    for (size_t i = 0; i < nv; i++) {
-        if (i == 0 || !same_key(&vpool, &vkeys[i - 1], &vkeys[i]))
-            eval_vertex[++e] = vkeys[i].item;
-        vertex_eval[vkeys[i].item] = (uint32_t)e;
-    }
-    rep.evaluations = ne;
-
-    /* 4. Evaluate, split by ranges across threads. */
-    cor_ctx ctx = {m, w, &cl, pairs, npairs, joints, 1.0 / (sigma * sigma), eval_vertex, eval_cor,
-                   ne};
     if (threads > 64)
         threads = 64;
-    if ((size_t)threads > ne / 64 + 1)
-        threads = (int)(ne / 64 + 1);
+    if ((size_t)threads > count / 16 + 1)
+        threads = (int)(count / 16 + 1);
     cor_job jobs[64];
     pthread_t tid[64];
     int started = 0;
-    stamps = calloc((size_t)threads * (ncl ? ncl : 1), sizeof *stamps);
-    if (!stamps)
-        goto oom;
     for (int i = 0; i < threads; i++)
-        jobs[i] = (cor_job){&ctx, ne * (size_t)i / (size_t)threads,
-                            ne * (size_t)(i + 1) / (size_t)threads,
-                            stamps + (size_t)i * (ncl ? ncl : 1)};
+        jobs[i] = (cor_job){ctx, count * (size_t)i / (size_t)threads,
+                            count * (size_t)(i + 1) / (size_t)threads, 0};
     for (int i = 1; i < threads; i++) {
         if (pthread_create(&tid[i], NULL, cor_run, &jobs[i]) != 0) {
             for (int q = i; q < threads; q++)
@@ -456,28 +304,187 @@ int pp_cor_compute(const pp_tetmesh *m, const pp_weights *w, const pp_cor_option
     cor_run(&jobs[0]);
     for (int i = 1; i <= started; i++)
         pthread_join(tid[i], NULL);
-    for (size_t v = 0; v < n; v++)
+    for (int i = 0; i < threads; i++)
+        *evaluations += jobs[i].evaluations;
+    return 0;
+}
+
+/* Key of a vertex's cell for one pair: quantized (a_i, a_j), or in exact
+ * mode the vertex itself (so the cell mean is the vertex's own weights). */
+static uint64_t cell_key(uint32_t pair, double ai, double aj, double inv_step, size_t v)
+{
+    if (inv_step == 0)
+        return ((uint64_t)pair << 40) | (uint64_t)v;
+    uint64_t qi = (uint64_t)(ai * inv_step), qj = (uint64_t)(aj * inv_step);
+    return ((uint64_t)pair << 40) | (qi << Q_BITS) | qj;
+}
+
+int pp_cor_compute(const pp_tetmesh *m, const pp_weights *w, const pp_cor_options *opt,
+                   float *cor, pp_cor_report *rep_out, char *err, size_t err_size)
+{
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    pp_cor_report rep;
+    memset(&rep, 0, sizeof rep);
+    double sigma = opt && opt->sigma > 0 ? opt->sigma : 0.1;
+    double step = opt && opt->tolerance != 0 ? opt->tolerance : 1.0 / 128;
+    int exact = step < 0;
+    double inv_step = exact ? 0 : 1.0 / step;
+    int threads = opt && opt->threads > 1 ? opt->threads : 1;
+    size_t n = m->vertex_count, nt = m->tet_count;
+    if (w->vertex_count != n) {
+        snprintf(err, err_size, "cor: weights for %zu vertices, mesh has %zu", w->vertex_count, n);
+        return POSE_ERR_INVALID_ARGUMENT;
+    }
+    if (!exact && !(inv_step >= 1 && inv_step < (double)(1u << Q_BITS))) {
+        snprintf(err, err_size, "cor: bin step %g out of range (%g..1)", step,
+                 1.0 / (1u << Q_BITS));
+        return POSE_ERR_INVALID_ARGUMENT;
+    }
+    uint32_t joints = 0;
+    for (size_t i = 0; i < n * w->influences; i++)
+        joints = w->joints[i] + 1u > joints ? w->joints[i] + 1u : joints;
+    if (joints > MAX_JOINTS) {
+        snprintf(err, err_size, "cor: %u joints; at most %u", joints, MAX_JOINTS);
+        return POSE_ERR_INVALID_ARGUMENT;
+    }
+    int rc = POSE_OK;
+    bin_table tab = {0};
+    int32_t *pair_id = malloc((size_t)joints * joints * sizeof *pair_id + 1);
+    uint32_t *pair_start = NULL;
+    bin *bins = NULL;
+    double *result = NULL;
+    if (!pair_id)
+        goto oom;
+    for (size_t i = 0; i < (size_t)joints * joints; i++)
+        pair_id[i] = -1;
+
+    /* 1. File every (tet, joint pair) into its bin. Exact mode keys by the
+     *    (tet, pair) itself so no two tets merge. */
+    uint32_t npairs = 0;
+    size_t entry = 0;
+    for (size_t t = 0; t < nt; t++) {
+        sparse_w s;
+        tet_mean_weights(m, w, t, &s);
+        if (s.n < 2)
+            continue;
+        rep.tets_used++;
+        double c[3], vol = tet_volume_centroid(m, t, c);
+        for (int x = 0; x < s.n; x++)
+            for (int y = x + 1; y < s.n; y++) {
+                int32_t *pid = &pair_id[(size_t)s.j[x] * joints + s.j[y]];
+                if (*pid < 0)
+                    *pid = (int32_t)npairs++;
+                uint64_t key;
+                if (exact) {
+                    key = ((uint64_t)*pid << 40) | (uint64_t)entry++;
+                } else {
+                    uint64_t qi = (uint64_t)(s.w[x] * inv_step), qj = (uint64_t)(s.w[y] * inv_step);
+                    key = ((uint64_t)*pid << 40) | (qi << Q_BITS) | qj;
+                }
+                bin_acc *a = table_get(&tab, key);
+                if (!a)
+                    goto oom;
+                a->v += vol;
+                for (int q = 0; q < 3; q++) {
+                    a->vc[q] += vol * c[q];
+                    a->vcb[0][q] += vol * c[q] * s.w[x];
+                    a->vcb[1][q] += vol * c[q] * s.w[y];
+                }
+                a->vb[0] += vol * s.w[x];
+                a->vb[1] += vol * s.w[y];
+            }
+    }
+    rep.pairs = npairs;
+    rep.bins = tab.count;
+
+    /* 2. Pair-major order; mean weights and centred moments per bin. The
+     *    pair id occupies the key's top bits, so a sort groups the pairs. */
+    qsort(tab.acc, tab.count, sizeof *tab.acc, cmp_acc);
+    pair_start = calloc((size_t)npairs + 1, sizeof *pair_start);
+    bins = malloc((tab.count ? tab.count : 1) * sizeof *bins);
+    if (!pair_start || !bins)
+        goto oom;
+    for (size_t i = 0; i < tab.count; i++) {
+        const bin_acc *a = &tab.acc[i];
+        bin *b = &bins[i];
+        pair_start[(a->key >> 40) + 1]++;
+        double inv = a->v > 0 ? 1.0 / a->v : 0;
+        b->v = a->v;
+        for (int k = 0; k < 2; k++)
+            b->b[k] = a->vb[k] * inv;
+        for (int q = 0; q < 3; q++) {
+            b->vc[q] = a->vc[q];
+            for (int k = 0; k < 2; k++)
+                b->m[k][q] = a->vcb[k][q] - b->b[k] * a->vc[q];
+        }
+    }
+    for (uint32_t p = 0; p < npairs; p++)
+        pair_start[p + 1] += pair_start[p];
+    free(tab.acc);
+    memset(&tab, 0, sizeof tab);
+
+    /* 3. Vertex cells: per pair, vertices with nearby (a_i, a_j) share one
+     *    evaluation at their mean, corrected to first order per vertex; the
+     *    number of cells saturates while the vertex count grows. */
+    for (size_t v = 0; v < n; v++) {
+        sparse_w s;
+        vertex_weights(w, v, &s);
+        if (s.n < 2)
+            continue;
+        rep.vertices_with_cor++;
+        for (int x = 0; x < s.n; x++)
+            for (int y = x + 1; y < s.n; y++) {
+                int32_t p = pair_id[(size_t)s.j[x] * joints + s.j[y]];
+                if (p < 0)
+                    continue;
+                bin_acc *a = table_get(&tab, cell_key((uint32_t)p, s.w[x], s.w[y], inv_step, v));
+                if (!a)
+                    goto oom;
+                a->vb[0] += s.w[x];
+                a->vb[1] += s.w[y];
+                a->v += 1;
+            }
+    }
+    rep.cells = tab.count;
+    result = malloc((tab.count ? tab.count : 1) * CELL_RESULT * sizeof *result);
+    if (!result)
+        goto oom;
+    cor_ctx ctx = {pair_start, bins, tab.acc, result, 1.0 / (sigma * sigma)};
+    run_jobs(&ctx, tab.count, threads, &rep.evaluations);
+
+    /* 4. Each vertex sums its pairs' cells. */
+    for (size_t v = 0; v < n; v++) {
+        sparse_w s;
+        vertex_weights(w, v, &s);
+        double num[3] = {0}, den = 0;
+        for (int x = 0; x < s.n; x++)
+            for (int y = x + 1; y < s.n; y++) {
+                int32_t p = pair_id[(size_t)s.j[x] * joints + s.j[y]];
+                if (p < 0)
+                    continue;
+                const bin_acc *a = table_get(&tab, cell_key((uint32_t)p, s.w[x], s.w[y], inv_step, v));
+                const double *r = result + CELL_RESULT * (size_t)(a - tab.acc);
+                double di = s.w[x] - a->vb[0] / a->v, dj = s.w[y] - a->vb[1] / a->v;
+                for (int q = 0; q < 3; q++)
+                    num[q] += r[q] + di * r[4 + q] + dj * r[8 + q];
+                den += r[3] + di * r[7] + dj * r[11];
+            }
         for (int q = 0; q < 3; q++)
-            cor[3 * v + q] = vertex_eval[v] == UINT32_MAX
-                                 ? m->positions[3 * v + q]
-                                 : (float)eval_cor[3 * (size_t)vertex_eval[v] + q];
+            cor[3 * v + q] = s.n >= 2 && den > 0 ? (float)(num[q] / den) : m->positions[3 * v + q];
+    }
     goto done;
 oom:
     snprintf(err, err_size, "cor: out of memory");
     rc = POSE_ERR_OUT_OF_MEMORY;
 done:
-    free(keys);
-    free(pool.j);
-    free(pool.q);
-    free(vkeys);
-    free(vpool.j);
-    free(vpool.q);
-    free(pairs);
-    free(eval_vertex);
-    free(vertex_eval);
-    free(eval_cor);
-    free(stamps);
-    clusters_free(&cl);
+    free(tab.keys);
+    free(tab.slot);
+    free(tab.acc);
+    free(pair_id);
+    free(pair_start);
+    free(bins);
+    free(result);
     clock_gettime(CLOCK_MONOTONIC, &t1);
     rep.seconds = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
     if (rep_out)

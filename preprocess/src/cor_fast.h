@@ -8,13 +8,19 @@
  * centroid. Vertices bound to one joint (and any vertex whose sums vanish)
  * get their own position: they move rigidly, where any centre is exact.
  *
- * The fast path exploits sparsity: s is non-zero only when both weight
- * vectors share two joints. Tets with fewer than two joints are dropped;
- * the rest are clustered by joint set and weights quantized to `tolerance`
- * (volume-weighted mean weights, summed V and V·c per cluster); clusters
- * are listed per joint pair, and a vertex visits only the clusters of its
- * own pairs, each once. Vertices whose quantized weights coincide share
- * one evaluation. Work is split across threads by vertex ranges.
+ * The fast path exploits sparsity and the formula's structure. s is a sum
+ * over joint pairs (i, j) shared by both vectors, and each pair's term
+ * depends on the tet only through (w̄_i, w̄_j). So tets are grouped by joint
+ * pair (a tet with joints {a,b,c} joins pairs ab, ac, bc; tets with one joint
+ * join none) and, within a pair, binned on a grid of (w̄_i, w̄_j) with step
+ * `tolerance`. Each bin keeps Σ V, Σ V c, its volume-weighted mean weights
+ * and the first moments Σ V c (w̄ - mean), so the term is evaluated once
+ * per bin with a first-order correction: the binning error is second order
+ * in the step. The vertex side is binned the same way: per pair, vertices
+ * whose (w_i, w_j) share a cell share one evaluation at their mean, with the
+ * derivatives along w_i, w_j for each vertex's own offset. Evaluations grow
+ * with (pairs x bins x cells), which saturates, not with the mesh size.
+ * Cells are split across threads.
  */
 #ifndef POSE_PP_COR_FAST_H
 #define POSE_PP_COR_FAST_H
@@ -24,16 +30,19 @@
 
 typedef struct pp_cor_options {
     double sigma;     /**< σ; 0 = 0.1 */
-    double tolerance; /**< weight quantum for clustering; 0 = 1e-4 (max deviation from the
-                           direct formula ~1e-4 of the model size); < 0 = no clustering */
+    double tolerance; /**< bin step in weight space; 0 = 1/128 (deviation from the direct
+                           formula ~2e-5 of the model size on the test bars); < 0 = exact (one bin per
+                           distinct weight pair: the direct formula, reordered) */
     int threads;      /**< <= 1 runs on the caller's thread */
 } pp_cor_options;
 
 typedef struct pp_cor_report {
     size_t vertices_with_cor; /**< vertices with two or more joints */
     size_t tets_used;         /**< tets with two or more joints */
-    size_t clusters;          /**< tet clusters after quantization */
-    size_t evaluations;       /**< distinct vertex weight vectors evaluated */
+    size_t pairs;             /**< joint pairs that occur in some tet */
+    size_t bins;              /**< (pair, tet weight cell) bins */
+    size_t cells;             /**< (pair, vertex weight cell) evaluations */
+    size_t evaluations;       /**< pair terms evaluated in all */
     double seconds;
 } pp_cor_report;
 

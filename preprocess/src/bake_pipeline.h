@@ -1,0 +1,103 @@
+/* SPDX-License-Identifier: Apache-2.0
+ *
+ * pose-bake's pipeline: meshes + skeleton template -> rig file.
+ *   load -> rig fit -> voxelize + label -> tetrahedralize -> weights ->
+ *   mapping -> CoR -> write (temporary file, then rename: never half-written)
+ * Every stage is timed and reported; a progress callback sees each stage
+ * start and finish with the overall fraction done.
+ */
+#ifndef POSE_PP_BAKE_PIPELINE_H
+#define POSE_PP_BAKE_PIPELINE_H
+
+#include "cor_fast.h"
+#include "embed_hash.h"
+#include "rig_fit.h"
+#include "template_json.h"
+#include "tetmesh.h"
+#include "voxelize.h"
+#include "weights_fem.h"
+
+/** Stages, in order. */
+typedef enum pp_bake_stage {
+    PP_STAGE_LOAD = 0,
+    PP_STAGE_RIG,
+    PP_STAGE_VOXELIZE,
+    PP_STAGE_TETRAHEDRALIZE,
+    PP_STAGE_WEIGHTS,
+    PP_STAGE_MAPPING,
+    PP_STAGE_COR,
+    PP_STAGE_WRITE,
+    PP_STAGE_COUNT
+} pp_bake_stage;
+
+const char *pp_bake_stage_name(pp_bake_stage s);
+
+/** Default voxel edge when neither resolution nor a vertex budget is given. */
+#define PP_BAKE_DEFAULT_RESOLUTION_MM 6.0
+
+typedef struct pp_bake_options {
+    const char *skin_path;
+    const char *const *bone_paths; /**< bone mesh files; each mesh's name is its file stem */
+    size_t bone_count;
+    const char *const *organ_paths; /**< extra tissues (soft; embedded only) */
+    size_t organ_count;
+    const char *template_path;
+    const char *output_path;
+    const char *vtu_path;           /**< optional: tet mesh with labels and weights */
+    double resolution_mm;           /**< voxel edge; 0: default (or from the budget) */
+    size_t target_vertices;         /**< tet vertex budget; 0: one lattice cell per voxel */
+    pp_tet_backend backend;
+    unsigned influences;            /**< K; 0 = 4 */
+    int threads;                    /**< 0 = 1 */
+    int no_cor;                     /**< skip CoR (rig without the CoR method) */
+    /** Called at each stage's start (fraction_done of the whole bake) and end. */
+    void (*progress)(pp_bake_stage stage, int finished, double fraction_done, void *user);
+    void *user;
+} pp_bake_options;
+
+/** Per-tissue mapping figures. */
+typedef struct pp_bake_tissue {
+    char name[PP_NAME_MAX];
+    pose_tissue_kind kind;
+    int joint;
+    size_t vertices, outside;
+    double max_distance;
+    size_t label_fallback;
+} pp_bake_tissue;
+
+typedef struct pp_bake_report {
+    double seconds[PP_STAGE_COUNT];
+    double total_seconds;
+    double peak_rss_mb;
+    pp_template tmpl;              /**< the template used (names, rules) */
+    pp_fit_joint *fits;            /**< tmpl.joint_count */
+    pp_voxel_report voxels;
+    float voxel_mm;
+    pp_tet_quality quality;
+    pp_weight_report weights;
+    pp_embed_report mapping;       /**< totals */
+    pp_bake_tissue *tissues;
+    size_t tissue_count;
+    pp_cor_report cor;
+    size_t soft_bones;             /**< bone files not in the template (kept as soft tissue) */
+    size_t rig_bytes;
+} pp_bake_report;
+
+/**
+ * Run the whole bake. On failure returns a negative pose_status, removes
+ * any partial output and writes a message naming the file, joint or stage
+ * into err. The report is filled as far as the bake got; free it with
+ * pp_bake_report_free in any case.
+ */
+int pp_bake(const pp_bake_options *opt, pp_bake_report *report, char *err, size_t err_size);
+void pp_bake_report_free(pp_bake_report *r);
+
+/** The report as JSON text (cJSON; caller frees with free()), or NULL. */
+char *pp_bake_report_json(const pp_bake_report *r, const pp_bake_options *opt);
+
+/** Write the tet mesh, labels and per-joint weights as a VTK XML
+ *  unstructured grid (.vtu, ASCII). */
+int pp_write_vtu(const char *path, const pp_tetmesh *mesh, const pp_weights *w,
+                 const pp_template *t, char *err, size_t err_size);
+
+#endif /* POSE_PP_BAKE_PIPELINE_H */

@@ -1,0 +1,360 @@
+/* SPDX-License-Identifier: Apache-2.0
+ *
+ * pose-bake: skin + bone meshes + skeleton template -> rig file.
+ * Exit status: 0 success, 1 the bake failed (message on stderr), 2 usage.
+ */
+#include "bake_pipeline.h"
+
+#include <ctype.h>
+#include <dirent.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: pose-bake --skin SKIN --bones DIR|FILE... --template TEMPLATE.json -o OUT.rig\n"
+            "                 [--organs DIR|FILE...] [--resolution MM | --target-vertices N]\n"
+            "                 [--backend lattice|tetgen] [-K N] [--threads N] [--no-cor]\n"
+            "                 [--vtu FILE] [--json] [--report FILE] [--quiet]\n"
+            "\n"
+            "Builds a rig for the pose runtime: fits the template's joints to the bones,\n"
+            "voxelizes and tetrahedralizes the body, computes harmonic skinning weights,\n"
+            "embeds every tissue vertex and computes centres of rotation.\n"
+            "\n"
+            "  --skin FILE            closed body surface (any format Assimp reads), metres\n"
+            "  --bones DIR|FILE...    bone meshes; a directory means every mesh file in it;\n"
+            "                         a mesh's name is its file stem (as the template names it)\n"
+            "  --organs DIR|FILE...   extra tissues, embedded and deformed with the body\n"
+            "  --template FILE        skeleton template (e.g. templates/full_body.json)\n"
+            "  -o, --output FILE      rig to write (written to a temporary file, then renamed)\n"
+            "  --resolution MM        voxel edge in millimetres (default %.0f)\n"
+            "  --target-vertices N    tet vertex budget (the lattice coarsens to meet it)\n"
+            "  --backend NAME         lattice (built in, default) or tetgen (AGPL build option)\n"
+            "  -K, --influences N     weights kept per vertex, 1..8 (default 4)\n"
+            "  --threads N            worker threads for mapping and CoR (default: cores)\n"
+            "  --no-cor               skip centres of rotation\n"
+            "  --vtu FILE             also write the tet mesh, labels and weights for ParaView\n"
+            "  --json                 print the report as JSON on stdout\n"
+            "  --report FILE          write the JSON report to FILE\n"
+            "  --quiet                no progress line\n"
+            "  --help, --version\n",
+            PP_BAKE_DEFAULT_RESOLUTION_MM);
+}
+
+typedef struct path_list {
+    char **v;
+    size_t n, cap;
+} path_list;
+
+static int push(path_list *l, const char *s)
+{
+    if (l->n == l->cap) {
+        size_t cap = l->cap ? 2 * l->cap : 32;
+        char **v = realloc(l->v, cap * sizeof *v);
+        if (!v)
+            return -1;
+        l->v = v;
+        l->cap = cap;
+    }
+    l->v[l->n] = strdup(s);
+    return l->v[l->n++] ? 0 : -1;
+}
+
+static void list_free(path_list *l)
+{
+    for (size_t i = 0; i < l->n; i++)
+        free(l->v[i]);
+    free(l->v);
+}
+
+static int is_mesh_file(const char *name)
+{
+    static const char *ext[] = {".obj", ".stl", ".ply", ".gltf", ".glb", ".fbx", ".off", ".dae", ".3ds"};
+    const char *dot = strrchr(name, '.');
+    if (!dot)
+        return 0;
+    for (size_t i = 0; i < sizeof ext / sizeof ext[0]; i++)
+        if (strcasecmp(dot, ext[i]) == 0)
+            return 1;
+    return 0;
+}
+
+static int cmp_str(const void *a, const void *b)
+{
+    return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+/* A directory adds its mesh files (sorted, for reproducible bakes). */
+static int add_path(path_list *l, const char *path, const char *what)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        fprintf(stderr, "pose-bake: %s %s: %s\n", what, path, strerror(errno));
+        return -1;
+    }
+    if (!S_ISDIR(st.st_mode))
+        return push(l, path);
+    DIR *d = opendir(path);
+    if (!d) {
+        fprintf(stderr, "pose-bake: %s %s: %s\n", what, path, strerror(errno));
+        return -1;
+    }
+    size_t first = l->n;
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        if (e->d_name[0] == '.' || !is_mesh_file(e->d_name))
+            continue;
+        size_t len = strlen(path) + strlen(e->d_name) + 2;
+        char *full = malloc(len);
+        if (!full) {
+            closedir(d);
+            return -1;
+        }
+        snprintf(full, len, "%s/%s", path, e->d_name);
+        int rc = push(l, full);
+        free(full);
+        if (rc < 0) {
+            closedir(d);
+            return -1;
+        }
+    }
+    closedir(d);
+    if (l->n == first) {
+        fprintf(stderr, "pose-bake: %s directory %s holds no mesh files\n", what, path);
+        return -1;
+    }
+    qsort(l->v + first, l->n - first, sizeof *l->v, cmp_str);
+    return 0;
+}
+
+static int parse_uint(const char *s, const char *opt, unsigned long lo, unsigned long hi,
+                      unsigned long *out)
+{
+    char *end;
+    errno = 0;
+    unsigned long v = s ? strtoul(s, &end, 10) : 0;
+    if (!s || errno || *end || end == s || v < lo || v > hi || s[0] == '-') {
+        fprintf(stderr, "pose-bake: %s needs an integer in %lu..%lu (got '%s')\n", opt, lo, hi,
+                s ? s : "");
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+typedef struct progress_state {
+    int tty;
+    double start;
+} progress_state;
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void on_progress(pp_bake_stage stage, int finished, double done, void *user)
+{
+    progress_state *p = user;
+    if (!p->tty)
+        return;
+    double el = now_s() - p->start;
+    char eta[32] = "";
+    if (done > 0.02)
+        snprintf(eta, sizeof eta, " ETA %.0f s", el * (1 - done) / done);
+    fprintf(stderr, "\r\033[Kpose-bake: [%d/%d] %-15s %3.0f%%%s", (int)stage + 1, PP_STAGE_COUNT,
+            pp_bake_stage_name(stage), 100 * done, finished && stage == PP_STAGE_COUNT - 1 ? "" : eta);
+    if (finished && stage == PP_STAGE_COUNT - 1)
+        fputc('\n', stderr);
+    fflush(stderr);
+}
+
+static void print_summary(const pp_bake_report *r, const pp_bake_options *o)
+{
+    printf("pose-bake: wrote %s (%.1f MB) in %.2f s, peak memory %.0f MB\n", o->output_path,
+           (double)r->rig_bytes / 1e6, r->total_seconds, r->peak_rss_mb);
+    printf("stages:");
+    for (int s = 0; s < PP_STAGE_COUNT; s++)
+        printf(" %s %.2f s%s", pp_bake_stage_name((pp_bake_stage)s), r->seconds[s],
+               s + 1 < PP_STAGE_COUNT ? "," : "\n");
+    printf("tet mesh (%s, voxel %.1f mm): %zu vertices, %zu tets, dihedral %.1f..%.1f deg, "
+           "radius-edge <= %.2f\n",
+           pp_tet_backend_name(o->backend), (double)r->voxel_mm, r->quality.vertex_count,
+           r->quality.tet_count, r->quality.min_dihedral_deg, r->quality.max_dihedral_deg,
+           r->quality.max_radius_edge);
+    printf("joints (centre in m, fit residual):\n");
+    for (size_t j = 0; j < r->tmpl.joint_count; j++) {
+        const pp_fit_joint *f = &r->fits[j];
+        printf("  %-12s %-6s (%7.4f %7.4f %7.4f)  %zu pts  r %.1f mm  rms %.2f mm\n",
+               r->tmpl.joints[j].name, pp_fit_rule_name(r->tmpl.joints[j].rule), f->centre[0],
+               f->centre[1], f->centre[2], f->contact_points, f->radius_mm, f->residual_mm);
+    }
+    const pp_weight_report *w = &r->weights;
+    printf("weights: %zu free + %zu bone vertices, %s factor nnz %zu; min %.3g max %.6g "
+           "|sum-1| <= %.2g (%s); largest dropped by K: %.3g\n",
+           w->free_vertices, w->fixed_vertices, w->supernodal ? "supernodal" : "simplicial",
+           w->factor_nnz, w->min_weight, w->max_weight, w->max_sum_error,
+           w->min_weight > -1e-6 && w->max_weight < 1 + 1e-6 && w->max_sum_error < 1e-6
+               ? "ok"
+               : "CHECK",
+           w->max_dropped);
+    if (w->floating_regions || w->empty_joints || w->conflict_vertices)
+        printf("weights: %zu soft islands pinned (%zu vertices), %zu joints without bone tets, "
+               "%zu vertices on two bones\n",
+               w->floating_regions, w->floating_vertices, w->empty_joints, w->conflict_vertices);
+    printf("mapping: %zu vertices, %zu outside the tet mesh (largest distance %.2f mm)\n",
+           r->mapping.vertices, r->mapping.outside, r->mapping.max_distance * 1e3);
+    for (size_t t = 0; t < r->tissue_count; t++)
+        if (r->tissues[t].outside)
+            printf("  %-14s %zu of %zu outside, up to %.2f mm\n", r->tissues[t].name,
+                   r->tissues[t].outside, r->tissues[t].vertices, r->tissues[t].max_distance * 1e3);
+    if (!o->no_cor)
+        printf("cor: %zu vertices; %zu tets in %zu joint pairs, %zu bins x %zu vertex cells; "
+               "%zu pair terms\n",
+               r->cor.vertices_with_cor, r->cor.tets_used, r->cor.pairs, r->cor.bins,
+               r->cor.cells, r->cor.evaluations);
+}
+
+int main(int argc, char **argv)
+{
+    pp_bake_options o = {0};
+    path_list bones = {0}, organs = {0};
+    int json = 0, quiet = 0, status = 2;
+    const char *report_path = NULL;
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    o.threads = cores > 0 ? (int)cores : 1;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *next = i + 1 < argc ? argv[i + 1] : NULL;
+        unsigned long u;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            usage(stdout);
+            status = 0;
+            goto out;
+        } else if (!strcmp(a, "--version")) {
+            printf("pose-bake %s\n", pose_version_string());
+            status = 0;
+            goto out;
+        } else if (!strcmp(a, "--bones") || !strcmp(a, "--organs")) {
+            path_list *l = a[2] == 'b' ? &bones : &organs;
+            if (!next || next[0] == '-') {
+                fprintf(stderr, "pose-bake: %s needs a directory or files\n", a);
+                goto out;
+            }
+            /* Every argument up to the next option: works with shell globs. */
+            while (i + 1 < argc && argv[i + 1][0] != '-')
+                if (add_path(l, argv[++i], a + 2) < 0) {
+                    status = 1;
+                    goto out;
+                }
+        } else if (!next && (!strcmp(a, "--skin") || !strcmp(a, "--template") || !strcmp(a, "-o") ||
+                             !strcmp(a, "--output") || !strcmp(a, "--resolution") ||
+                             !strcmp(a, "--target-vertices") || !strcmp(a, "--backend") ||
+                             !strcmp(a, "-K") || !strcmp(a, "--influences") ||
+                             !strcmp(a, "--threads") || !strcmp(a, "--vtu") ||
+                             !strcmp(a, "--report"))) {
+            fprintf(stderr, "pose-bake: %s needs a value\n", a);
+            goto out;
+        } else if (!strcmp(a, "--skin")) {
+            o.skin_path = argv[++i];
+        } else if (!strcmp(a, "--template")) {
+            o.template_path = argv[++i];
+        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+            o.output_path = argv[++i];
+        } else if (!strcmp(a, "--vtu")) {
+            o.vtu_path = argv[++i];
+        } else if (!strcmp(a, "--report")) {
+            report_path = argv[++i];
+        } else if (!strcmp(a, "--resolution")) {
+            char *end;
+            o.resolution_mm = strtod(argv[++i], &end);
+            if (*end || !(o.resolution_mm >= 0.2 && o.resolution_mm <= 100)) {
+                fprintf(stderr, "pose-bake: --resolution needs millimetres in 0.2..100 (got '%s')\n",
+                        argv[i]);
+                goto out;
+            }
+        } else if (!strcmp(a, "--target-vertices")) {
+            if (parse_uint(argv[++i], a, 100, 100000000, &u) < 0)
+                goto out;
+            o.target_vertices = u;
+        } else if (!strcmp(a, "--backend")) {
+            if (pp_tet_backend_parse(argv[++i], &o.backend) < 0) {
+                fprintf(stderr, "pose-bake: --backend is lattice or tetgen (got '%s')\n", argv[i]);
+                goto out;
+            }
+        } else if (!strcmp(a, "-K") || !strcmp(a, "--influences")) {
+            if (parse_uint(argv[++i], a, 1, PP_MAX_INFLUENCES, &u) < 0)
+                goto out;
+            o.influences = (unsigned)u;
+        } else if (!strcmp(a, "--threads")) {
+            if (parse_uint(argv[++i], a, 1, 64, &u) < 0)
+                goto out;
+            o.threads = (int)u;
+        } else if (!strcmp(a, "--no-cor")) {
+            o.no_cor = 1;
+        } else if (!strcmp(a, "--json")) {
+            json = 1;
+        } else if (!strcmp(a, "--quiet")) {
+            quiet = 1;
+        } else {
+            fprintf(stderr, "pose-bake: unknown argument '%s' (see --help)\n", a);
+            goto out;
+        }
+    }
+    if (!o.skin_path || !bones.n || !o.template_path || !o.output_path) {
+        fprintf(stderr, "pose-bake: --skin, --bones, --template and -o are required (see --help)\n");
+        goto out;
+    }
+    if (o.resolution_mm > 0 && o.target_vertices) {
+        fprintf(stderr, "pose-bake: give --resolution or --target-vertices, not both\n");
+        goto out;
+    }
+    if (o.target_vertices && o.resolution_mm == 0)
+        o.resolution_mm = 4.0; /* a fine image for the lattice to coarsen from */
+    o.bone_paths = (const char *const *)bones.v;
+    o.bone_count = bones.n;
+    o.organ_paths = (const char *const *)organs.v;
+    o.organ_count = organs.n;
+    progress_state ps = {!quiet && isatty(STDERR_FILENO), now_s()};
+    o.progress = on_progress;
+    o.user = &ps;
+
+    pp_bake_report rep;
+    char err[1024];
+    int rc = pp_bake(&o, &rep, err, sizeof err);
+    if (ps.tty && rc < 0)
+        fputc('\n', stderr);
+    if (rc < 0) {
+        fprintf(stderr, "pose-bake: %s\n", err);
+        status = 1;
+    } else {
+        status = 0;
+        char *text = (json || report_path) ? pp_bake_report_json(&rep, &o) : NULL;
+        if (json && text)
+            printf("%s\n", text);
+        else if (!json)
+            print_summary(&rep, &o);
+        if (report_path) {
+            FILE *f = fopen(report_path, "w");
+            if (!f || !text || fputs(text, f) < 0 || fclose(f) != 0) {
+                fprintf(stderr, "pose-bake: %s: cannot write the report: %s\n", report_path,
+                        strerror(errno));
+                status = 1;
+            }
+        }
+        free(text);
+    }
+    pp_bake_report_free(&rep);
+out:
+    list_free(&bones);
+    list_free(&organs);
+    return status;
+}
