@@ -10,7 +10,6 @@
 #include <stdint.h>
 
 #include "rt_kernels.h"
-#include "rt_simd.h"
 #include "rt_vec.h"
 
 #define WSCALE (1.0f / 32768.0f)

@@ -53,17 +53,6 @@ static inline float pose__quat_normalize(float q[4])
     return n;
 }
 
-/** Row-major 3x3 rotation matrix of a unit quaternion. */
-static inline void pose__quat_to_mat3(float m[9], const float q[4])
-{
-    float x = q[0], y = q[1], z = q[2], w = q[3];
-    float xx = x * x, yy = y * y, zz = z * z;
-    float xy = x * y, xz = x * z, yz = y * z, wx = w * x, wy = w * y, wz = w * z;
-    m[0] = 1.0f - 2.0f * (yy + zz); m[1] = 2.0f * (xy - wz);        m[2] = 2.0f * (xz + wy);
-    m[3] = 2.0f * (xy + wz);        m[4] = 1.0f - 2.0f * (xx + zz); m[5] = 2.0f * (yz - wx);
-    m[6] = 2.0f * (xz - wy);        m[7] = 2.0f * (yz + wx);        m[8] = 1.0f - 2.0f * (xx + yy);
-}
-
 /** out = R(q) v (out may alias v). */
 static inline void pose__quat_rotate(float out[3], const float q[4], const float v[3])
 {

@@ -13,6 +13,12 @@
 #  include <immintrin.h>
 #endif
 
+#if defined(__GNUC__) || defined(__clang__)
+#  define POSE__INLINE inline __attribute__((always_inline))
+#else
+#  define POSE__INLINE inline
+#endif
+
 typedef float pose__v8f __attribute__((vector_size(32)));
 typedef int32_t pose__v8i __attribute__((vector_size(32)));
 typedef uint16_t pose__v8u16 __attribute__((vector_size(16)));

@@ -339,7 +339,8 @@ POSE_API pose_status pose_set_joint_euler(pose_state *state, int joint, const fl
 POSE_API pose_status pose_get_joint(const pose_state *state, int joint, float quat_xyzw[4]);
 /**
  * Place the whole model: applied on top of the root joints' rest frames,
- * p' = R p + t in model space. @since 0.1
+ * p' = R p + t in model space. Either pointer may be NULL (no translation /
+ * no rotation). @since 0.1
  */
 POSE_API pose_status pose_set_root(pose_state *state, const float translation[3],
                                    const float quat_xyzw[4]);
