@@ -206,6 +206,8 @@ pose_status pb_hid_replay_create(pb_hid_recording *rec, const char *origin, cons
     for (size_t i = 0; i < rec->event_count; i++)
         if (rec->events[i].device == r->opt.device)
             r->events[r->count++] = (uint32_t)i;
+    if (r->opt.absent_ms > 0)
+        r->gone_until = pb_hid_now_ns() + (int64_t)r->opt.absent_ms * 1000000;
     return pb_hid_source_create(&r->base, &r->opt.source, out, err);
 }
 

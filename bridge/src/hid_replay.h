@@ -34,6 +34,7 @@ typedef struct pb_hid_replay_options {
     int as_fast_as_possible;  /**< ignore timing: each read returns the next report */
     int loop;                 /**< restart at the end; times keep increasing */
     unsigned device;          /**< device index in the file (D: n) */
+    int absent_ms;            /**< the device is plugged in only this long after the source is made */
     const pb_hid_fault *faults; /**< copied */
     size_t fault_count;
 } pb_hid_replay_options;

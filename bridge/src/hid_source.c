@@ -97,9 +97,22 @@ pose_status pb_hid_source_create(pb_hid_transport *t, const pb_hid_source_option
     if (s->opt.reopen_ms <= 0)
         s->opt.reopen_ms = 1000;
     size_t len = 0;
-    pose_status st = t->ops->open(t, s->desc_bytes, sizeof s->desc_bytes, &len, err);
+    pb_error absent;
+    pose_status st = t->ops->open(t, s->desc_bytes, sizeof s->desc_bytes, &len, &absent);
+    int waiting_for_device = 0;
     if (st == POSE_OK) {
         s->open = 1;
+    } else if (st == POSE_ERR_NOT_FOUND && s->opt.expected_desc && s->opt.expected_desc_len <= sizeof s->desc_bytes) {
+        /* Not plugged in yet: take the channels from the descriptor it will have. */
+        len = s->opt.expected_desc_len;
+        memcpy(s->desc_bytes, s->opt.expected_desc, len);
+        waiting_for_device = 1;
+        st = POSE_OK;
+    } else if (err) {
+        *err = absent;
+    }
+    s->opt.expected_desc = NULL; /* not kept: the caller's buffer may go away */
+    if (st == POSE_OK) {
         s->desc_len = len;
         st = pb_hid_desc_parse(s->desc_bytes, len, t->origin, &s->desc, err);
     }
@@ -123,9 +136,12 @@ pose_status pb_hid_source_create(pb_hid_transport *t, const pb_hid_source_option
     s->base.channel_count = s->desc->channel_count;
     for (size_t i = 0; i < s->desc->channel_count; i++)
         s->values[i] = NAN;
-    s->base.state = PB_SOURCE_WAITING;
-    snprintf(s->base.message, sizeof s->base.message, "%s: open, no report yet", t->origin);
-    s->last_good_ns = pb_hid_now_ns();
+    s->base.state = waiting_for_device ? PB_SOURCE_DISCONNECTED : PB_SOURCE_WAITING;
+    if (waiting_for_device)
+        snprintf(s->base.message, sizeof s->base.message, "%.200s", absent.message);
+    else
+        snprintf(s->base.message, sizeof s->base.message, "%s: open, no report yet", t->origin);
+    s->last_good_ns = s->next_reopen_ns = pb_hid_now_ns();
     *out = &s->base;
     return POSE_OK;
 }

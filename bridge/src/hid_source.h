@@ -62,6 +62,14 @@ struct pb_hid_transport {
 typedef struct pb_hid_source_options {
     int stale_ms;  /**< silence that makes the source STALE (default 500) */
     int reopen_ms; /**< interval of reopen attempts after a disconnect (default 1000) */
+    /**
+     * The descriptor the device is known to have (e.g. the mannequin's), or
+     * NULL. With it, a device that is not plugged in yet is no error: the
+     * source starts DISCONNECTED with that descriptor's channels and opens
+     * the device when it appears (a device with another descriptor is a FAULT).
+     */
+    const uint8_t *expected_desc;
+    size_t expected_desc_len;
 } pb_hid_source_options;
 
 /** Counters since creation. */
@@ -76,8 +84,9 @@ typedef struct pb_hid_source_stats {
 /**
  * Make a source over a transport (ownership passes to the source, even on
  * failure). Opens the device once to learn its descriptor and channels;
- * POSE_ERR_NOT_FOUND when it is not there, POSE_ERR_FORMAT for a bad
- * descriptor. Destroy with pb_source_destroy.
+ * POSE_ERR_NOT_FOUND when it is not there (unless opt->expected_desc says
+ * what it will be), POSE_ERR_FORMAT for a bad descriptor. Destroy with
+ * pb_source_destroy.
  */
 pose_status pb_hid_source_create(pb_hid_transport *t, const pb_hid_source_options *opt, pb_source **out,
                                  pb_error *err);

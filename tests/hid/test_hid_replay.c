@@ -45,6 +45,12 @@ static void test_invalid(void **state)
     assert_int_equal(pb_hid_open("/nonexistent.hid", NULL, &src, &err), POSE_ERR_IO);
     assert_int_equal(pb_hid_open("hid:12345:1", NULL, &src, &err), POSE_ERR_INVALID_ARGUMENT);
     assert_int_equal(pb_hid_open("hid:1209", NULL, &src, &err), POSE_ERR_INVALID_ARGUMENT);
+    /* No such live device here: enumeration finds nothing (or hidapi is not built in). */
+    pose_status st = pb_hid_open("hid:ffff:fffe", NULL, &src, &err);
+    assert_true(st == POSE_ERR_NOT_FOUND || st == POSE_ERR_UNSUPPORTED);
+    assert_null(src);
+    st = pb_hid_open("/dev/hidraw999", NULL, &src, &err);
+    assert_true(st == POSE_ERR_NOT_FOUND || st == POSE_ERR_UNSUPPORTED);
     char path[1024];
     data_path(path, sizeof path, "mannequin_arm_raise.hid");
     pb_hid_replay_options opt = {.device = 3};
@@ -206,6 +212,59 @@ static void test_faults(void **state)
     pb_source_destroy(src);
 }
 
+/* Started before the device is plugged in: channels from the expected
+ * descriptor, DISCONNECTED until it appears; a device with another
+ * descriptor is refused. */
+static void test_expected_descriptor(void **state)
+{
+    (void)state;
+    pb_hid_replay_options opt = {
+        .source = {.reopen_ms = 20,
+                   .expected_desc = pb_mannequin_descriptor,
+                   .expected_desc_len = pb_mannequin_descriptor_len},
+        .as_fast_as_possible = 1,
+        .absent_ms = 100,
+    };
+    pb_source *src = open_replay("mannequin_reach_1khz.hid", &opt);
+    assert_int_equal(src->state, PB_SOURCE_DISCONNECTED);
+    assert_non_null(strstr(src->message, "not present"));
+    assert_int_equal(src->channel_count, 18);
+    assert_string_equal(src->channels[12].name, "Ordinal.13");
+    pb_update u;
+    assert_int_equal(pb_source_read(src, &u, 0), 0); /* still absent */
+    int got = 0;
+    for (int i = 0; i < 100 && !got; i++)
+        got = pb_source_read(src, &u, 20) == 1;
+    assert_true(got);
+    assert_int_equal(src->state, PB_SOURCE_OK);
+    assert_int_equal((long)u.values[17], 0); /* as fast as possible: nothing skipped */
+    assert_int_equal(pb_hid_source_get_stats(src).reopens, 1);
+    pb_source_destroy(src);
+
+    /* The same device where a mouse was expected. */
+    static const uint8_t mouse[] = {0x05, 0x01, 0x09, 0x02, 0xA1, 0x01, 0x09, 0x30, 0x15, 0x81, 0x25, 0x7F,
+                                    0x75, 0x08, 0x95, 0x01, 0x81, 0x06, 0xC0};
+    opt.source.expected_desc = mouse;
+    opt.source.expected_desc_len = sizeof mouse;
+    src = open_replay("mannequin_reach_1khz.hid", &opt);
+    assert_int_equal(src->channel_count, 1);
+    for (int i = 0; i < 20; i++)
+        assert_int_equal(pb_source_read(src, &u, 20), 0);
+    assert_int_equal(src->state, PB_SOURCE_FAULT);
+    assert_non_null(strstr(src->message, "different report descriptor"));
+    pb_source_destroy(src);
+
+    /* Without an expected descriptor, an absent device is an error at once. */
+    opt.source.expected_desc = NULL;
+    opt.source.expected_desc_len = 0;
+    char path[1024];
+    data_path(path, sizeof path, "mannequin_reach_1khz.hid");
+    pb_error err;
+    assert_int_equal(pb_hid_open(path, &opt, &src, &err), POSE_ERR_NOT_FOUND);
+    assert_null(src);
+    assert_non_null(strstr(err.message, "not present"));
+}
+
 static void test_seek_and_loop(void **state)
 {
     (void)state;
@@ -234,6 +293,7 @@ int main(void)
         cmocka_unit_test(test_invalid),
         cmocka_unit_test(test_decode_matches_generator),
         cmocka_unit_test(test_faults),
+        cmocka_unit_test(test_expected_descriptor),
         cmocka_unit_test(test_seek_and_loop),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
