@@ -381,7 +381,8 @@ void pb_runner_seek(pb_runner *r, double media_s)
 void pb_runner_step(pb_runner *r, int ticks)
 {
     pthread_mutex_lock(&r->mu);
-    r->step_req += ticks > 0 ? ticks : 0;
+    if (r->paused) /* steps only make sense while paused; none queue up during playback */
+        r->step_req += ticks > 0 ? ticks : 0;
     pthread_cond_broadcast(&r->cv);
     pthread_mutex_unlock(&r->mu);
 }

@@ -66,7 +66,7 @@ const pb_pose *pb_runner_latest(pb_runner *r, int *fresh);
 void pb_runner_stats_get(pb_runner *r, pb_runner_stats *out);
 void pb_runner_pause(pb_runner *r, int paused);
 void pb_runner_seek(pb_runner *r, double media_s);
-/** While paused: advance by one period and publish that pose. */
+/** While paused: publish the next `ticks` poses, one period apart (ignored while playing). */
 void pb_runner_step(pb_runner *r, int ticks);
 void pb_runner_set_speed(pb_runner *r, double speed);
 /** Block until the runner has ended on its own (limit or clip end) or timeout_ms (-1 forever). 1 ended, 0 timeout. */

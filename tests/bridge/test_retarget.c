@@ -295,6 +295,61 @@ static void test_recording_replays_same_targets(void **state)
     pb_clip_free(clip);
 }
 
+/* a quaternion One Euro filter from the mapping: the first pose passes, a
+ * jump is followed part way (the filter's alpha), a held pose converges */
+static void test_filtered_retarget(void **state)
+{
+    (void)state;
+    pb_clip *clip = load("mocap/cmu-bvh/131_01.bvh", NULL);
+    pb_rig_skel *rig;
+    pb_mapping *map;
+    pb_retarget *rt;
+    pb_error err;
+    assert_int_equal(pb_rig_skel_from_clip(clip, 1.0, &rig, &err), POSE_OK);
+    const char *js = "{\"joints\": {\"RightElbow\": {\"source\": \"RightElbow\", \"filter\": {\"min_cutoff\": 1.0, \"beta\": 0}}}}";
+    assert_int_equal(pb_mapping_parse(js, strlen(js), "m.json", &map, &err), POSE_OK);
+    if (pb_retarget_create(map, clip, rig, &rt, &err) != POSE_OK)
+        fail_msg("%s", err.message);
+    int j = pb_rig_skel_find(rig, "RightElbow");
+    size_t n = (size_t)clip->joint_count;
+    double *s = malloc(n * 14 * sizeof(double));
+    double (*lq)[4] = (double (*)[4])s, (*lt)[3] = (double (*)[3])(s + 4 * n);
+    double (*wq)[4] = (double (*)[4])(s + 7 * n), (*wp)[3] = (double (*)[3])(s + 11 * n);
+    pb_pose pose;
+    assert_int_equal(pb_pose_init(&pose, rig->joint_count), 0);
+    pb_clip_local(clip, pb_clip_frame(clip, 0), lq, lt);
+    double a[4], b[4], got[4];
+    pb_retarget_apply(rt, (const double (*)[4])lq, (const double (*)[3])lt, 0.01, &pose);
+    for (int k = 0; k < 4; k++)
+        a[k] = pose.q[j][k];
+    /* only this joint is driven, its rig parents stay at rest: its target is
+     * the clip joint's world rotation (the reference pose is all zeros) */
+    pb_clip_world(clip, (const double (*)[4])lq, (const double (*)[3])lt, wq, wp);
+    assert_true(bt_quat_angle_deg(a, wq[j]) < 1e-4); /* passes unfiltered */
+    pb_clip_local(clip, pb_clip_frame(clip, 600), lq, lt);
+    pb_clip_world(clip, (const double (*)[4])lq, (const double (*)[3])lt, wq, wp);
+    for (int k = 0; k < 4; k++)
+        b[k] = wq[j][k];
+    double whole = bt_quat_angle_deg(a, b);
+    assert_true(whole > 5.0);
+    pb_retarget_apply(rt, (const double (*)[4])lq, (const double (*)[3])lt, 0.01, &pose);
+    for (int k = 0; k < 4; k++)
+        got[k] = pose.q[j][k];
+    double alpha = pb_one_euro_alpha(1.0, 0.01); /* beta 0: the cutoff stays at min_cutoff */
+    assert_near(bt_quat_angle_deg(a, got), alpha * whole, 1e-3);
+    for (int i = 0; i < 2000; i++)
+        pb_retarget_apply(rt, (const double (*)[4])lq, (const double (*)[3])lt, 0.01, &pose);
+    for (int k = 0; k < 4; k++)
+        got[k] = pose.q[j][k];
+    assert_true(bt_quat_angle_deg(got, b) < 1e-3);
+    pb_pose_free(&pose);
+    free(s);
+    pb_retarget_free(rt);
+    pb_mapping_free(map);
+    pb_rig_skel_free(rig);
+    pb_clip_free(clip);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -302,6 +357,7 @@ int main(void)
         cmocka_unit_test(test_identical_skeleton_asf_amc),
         cmocka_unit_test(test_body_template_limb_directions),
         cmocka_unit_test(test_recording_replays_same_targets),
+        cmocka_unit_test(test_filtered_retarget),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
