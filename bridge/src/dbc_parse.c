@@ -19,6 +19,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define PB_DBC_MAX_FILE (64u << 20)
+
 /* ---- arena ------------------------------------------------------------ */
 
 struct pb_dbc_arena {
@@ -878,6 +880,14 @@ int pb_dbc_load(const char *path, pb_dbc **out, pb_dbc_error *err)
         n += r;
         if (r == 0)
             break;
+        if (n > PB_DBC_MAX_FILE) { /* the largest real DBCs are a few MB; this is not one */
+            free(buf);
+            fclose(f);
+            if (err)
+                snprintf(err->message, sizeof err->message, "%s: larger than %u MiB", path,
+                         PB_DBC_MAX_FILE >> 20);
+            return -1;
+        }
     }
     int bad = ferror(f);
     fclose(f);
