@@ -22,15 +22,6 @@
 #define POSE_SOURCE_DIR_DEFAULT "."
 #endif
 
-static const char *const body[][2] = {
-    {"pelvis", NULL},       {"lumbar", "pelvis"},     {"thorax", "lumbar"},        {"neck", "thorax"},
-    {"head", "neck"},       {"clavicle_r", "thorax"}, {"shoulder_r", "clavicle_r"}, {"elbow_r", "shoulder_r"},
-    {"wrist_r", "elbow_r"}, {"clavicle_l", "thorax"}, {"shoulder_l", "clavicle_l"}, {"elbow_l", "shoulder_l"},
-    {"wrist_l", "elbow_l"}, {"hip_r", "pelvis"},      {"knee_r", "hip_r"},         {"ankle_r", "knee_r"},
-    {"hip_l", "pelvis"},    {"knee_l", "hip_l"},      {"ankle_l", "knee_l"},
-};
-enum { BODY_JOINTS = sizeof body / sizeof body[0] };
-
 static void die(const char *what, const pb_error *err)
 {
     fprintf(stderr, "bench_hid: %s: %s\n", what, err ? err->message : "");
@@ -39,19 +30,9 @@ static void die(const char *what, const pb_error *err)
 
 static pb_rig_skel *body_skel(void)
 {
-    pose_joint_desc j[BODY_JOINTS];
-    memset(j, 0, sizeof j);
-    for (int i = 0; i < BODY_JOINTS; i++) {
-        j[i].name = body[i][0];
-        j[i].parent = -1;
-        for (int k = 0; k < i; k++)
-            if (body[i][1] && strcmp(body[k][0], body[i][1]) == 0)
-                j[i].parent = k;
-        j[i].rest_model.rotation[3] = 1.0f;
-    }
     pb_rig_skel *s;
     pb_error err;
-    if (pb_rig_skel_from_desc(j, BODY_JOINTS, &s, &err) != POSE_OK)
+    if (pb_mannequin_body_skel(&s, &err) != POSE_OK)
         die("rig", &err);
     return s;
 }

@@ -21,14 +21,6 @@
 #include "rig_skel.h"
 #include "runner.h"
 
-static const char *const BODY[][2] = {
-    {"pelvis", ""}, {"lumbar", "pelvis"}, {"thorax", "lumbar"}, {"neck", "thorax"}, {"head", "neck"},
-    {"clavicle_r", "thorax"}, {"shoulder_r", "clavicle_r"}, {"elbow_r", "shoulder_r"}, {"wrist_r", "elbow_r"},
-    {"clavicle_l", "thorax"}, {"shoulder_l", "clavicle_l"}, {"elbow_l", "shoulder_l"}, {"wrist_l", "elbow_l"},
-    {"hip_r", "pelvis"}, {"knee_r", "hip_r"}, {"ankle_r", "knee_r"}, {"hip_l", "pelvis"}, {"knee_l", "hip_l"},
-    {"ankle_l", "knee_l"},
-};
-
 /* Rotation about y by deg: {0, sin(deg/2), 0, cos(deg/2)}. */
 static void assert_about_y(const float q[4], double deg, double tol)
 {
@@ -40,20 +32,9 @@ static void assert_about_y(const float q[4], double deg, double tol)
 static void test_runner_hid_replay(void **state)
 {
     (void)state;
-    enum { N = sizeof BODY / sizeof BODY[0] };
-    pose_joint_desc j[N];
-    memset(j, 0, sizeof j);
-    for (int i = 0; i < N; i++) {
-        j[i].name = BODY[i][0];
-        j[i].parent = -1;
-        for (int k = 0; k < i; k++)
-            if (strcmp(BODY[k][0], BODY[i][1]) == 0)
-                j[i].parent = k;
-        j[i].rest_model.rotation[3] = 1;
-    }
     pb_rig_skel *skel = NULL;
     pb_error err;
-    assert_int_equal(pb_rig_skel_from_desc(j, N, &skel, &err), POSE_OK);
+    assert_int_equal(pb_mannequin_body_skel(&skel, &err), POSE_OK);
     char map_path[1024], rec[1024];
     snprintf(map_path, sizeof map_path, "%s/../bridge/maps/hid_mannequin_full_body.json", getenv("POSE_DATA_DIR"));
     snprintf(rec, sizeof rec, "%s/hid/mannequin_sit_to_stand.hid", getenv("POSE_DATA_DIR"));
