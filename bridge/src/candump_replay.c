@@ -64,7 +64,8 @@ static int replay_read(pb_source *src, pb_update *out, int timeout_ms)
         if (!s->have_pending && !fetch(s)) {
             if (s->opt.loop && s->reader.frames > 0) {
                 /* Start over one mean frame period after the last frame. */
-                const int64_t gap = s->reader.frames > 1 ? s->last_rel_ns / (int64_t)s->reader.frames : 1000000;
+                const int64_t span = s->last_rel_ns - s->loop_base_ns;
+                const int64_t gap = s->reader.frames > 1 ? span / (int64_t)(s->reader.frames - 1) : 1000000;
                 s->loop_base_ns = s->last_rel_ns + (gap > 0 ? gap : 1);
                 s->first_ns = INT64_MIN;
                 if (pb_candump_rewind(&s->reader) != 0 || !fetch(s)) {

@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include <cmocka.h>
 
@@ -384,6 +385,59 @@ static void test_bar_mapping(void **state)
     pb_mapping_free(map);
 }
 
+/* A three-frame log: looping keeps time moving forward, recorded timing
+ * takes the recorded time, as fast as possible does not. */
+static void test_replay_loop_and_timing(void **state)
+{
+    (void)state;
+    char path[1024];
+    snprintf(path, sizeof path, "%s/three.log", getenv("POSE_TEST_TMP"));
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    /* KNEE_L 0x10B: 90 deg = 40 19 01; 45 deg = A0 8C 00 */
+    fputs("(1000.000000) can0 10B#4019010000000000\n"
+          "(1000.040000) can0 10B#A08C000000000000\n"
+          "(1000.080000) can0 10B#4019010000000000\n",
+          f);
+    fclose(f);
+    const char *const knee[] = {"KNEE_L.flex"};
+    for (int mode = 0; mode < 2; mode++) {
+        pb_can_bus *bus = load_bus("bridge/maps/can_rig_fullbody.json");
+        assert_int_equal(pb_can_bus_select(bus, knee, 1), POSE_OK);
+        pb_source *src = NULL;
+        pb_error err;
+        pb_candump_replay_options opt = {.as_fast_as_possible = mode == 0, .loop = mode == 0};
+        assert_int_equal(pb_candump_replay_open(path, bus, &opt, &src, &err), POSE_OK);
+        pb_update u;
+        struct timespec a, b;
+        clock_gettime(CLOCK_MONOTONIC, &a);
+        if (mode == 0) {
+            static const double want[7] = {90, 45, 90, 90, 45, 90, 90};
+            int64_t prev = -1;
+            for (int i = 0; i < 7; i++) {
+                assert_int_equal(src->ops->read(src, &u, 0), 1);
+                assert_true(u.values[0] == want[i]);
+                assert_true(u.t_ns > prev);
+                prev = u.t_ns;
+            }
+            /* each pass starts one mean frame period (80 ms / 2) after the last frame:
+             * 0 40 80 | 120 160 200 | 240 */
+            assert_true(prev == 240000000);
+            assert_true(src->state != PB_SOURCE_ENDED);
+        } else {
+            int n = 0;
+            while (src->ops->read(src, &u, 200) >= 0)
+                n++;
+            assert_int_equal(n, 3);
+            assert_int_equal(src->state, PB_SOURCE_ENDED);
+            clock_gettime(CLOCK_MONOTONIC, &b);
+            const double wall = (double)(b.tv_sec - a.tv_sec) + (b.tv_nsec - a.tv_nsec) * 1e-9;
+            assert_true(wall >= 0.075 && wall < 1.0); /* 80 ms recorded */
+        }
+        pb_source_destroy(src);
+    }
+}
+
 static void test_bus_json_errors(void **state)
 {
     (void)state;
@@ -429,6 +483,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bus_json_errors),
+        cmocka_unit_test(test_replay_loop_and_timing),
         cmocka_unit_test(test_decode_matches_truth),
         cmocka_unit_test(test_full_body_mapping),
         cmocka_unit_test(test_bar_mapping),
