@@ -76,8 +76,9 @@ static int vhash_grow(vhash *h)
     return 0;
 }
 
-/* Id of vertex k, created when `create`; UINT32_MAX when absent (or no memory). */
-static uint32_t vhash_get(vhash *h, uint64_t k, int create)
+/* Id of vertex k, created as *next when `create`; UINT32_MAX when absent (or
+ * no memory). */
+static uint32_t vhash_get(vhash *h, uint64_t k, int create, uint32_t *next)
 {
     if (create && 2 * (h->count + 1) > h->cap && vhash_grow(h) != 0)
         return UINT32_MAX;
@@ -92,14 +93,21 @@ static uint32_t vhash_get(vhash *h, uint64_t k, int create)
     if (!create)
         return UINT32_MAX;
     h->key[s] = k;
-    h->val[s] = (uint32_t)h->count;
-    return (uint32_t)h->count++;
+    h->val[s] = (*next)++;
+    h->count++;
+    return h->val[s];
 }
 
 typedef struct builder {
     const pp_cells *L;
     uint8_t *lvl;
+    /* Vertices at whole-cell coordinates (leaf corners, edge midpoints, centres
+     * of leaves two or more cells wide) live in a dense grid; the odd ones
+     * (centres of one-cell leaves and of their faces) in a hash. */
+    uint32_t *dense;
+    size_t dn[3];
     vhash vh;
+    uint32_t nv;
     uint32_t *tets;
     uint16_t *labels;
     size_t tet_count, tet_cap;
@@ -259,7 +267,14 @@ static void face_point(int a, int64_t pa, int64_t pu, int64_t pw, int64_t out[3]
 
 static uint32_t vid_of(builder *b, const int64_t p[3], int create)
 {
-    uint32_t id = vhash_get(&b->vh, vkey(p[0], p[1], p[2]), create);
+    if (!((p[0] | p[1] | p[2]) & 1)) {
+        uint32_t *d = &b->dense[(size_t)(p[0] / 2) +
+                                b->dn[0] * ((size_t)(p[1] / 2) + b->dn[1] * (size_t)(p[2] / 2))];
+        if (*d == UINT32_MAX && create)
+            *d = b->nv++;
+        return *d;
+    }
+    uint32_t id = vhash_get(&b->vh, vkey(p[0], p[1], p[2]), create, &b->nv);
     if (create && id == UINT32_MAX)
         b->oom = 1;
     return id;
@@ -366,11 +381,16 @@ pose_status pp_tet_octree_build(const pp_cells *L, int grading, pp_tetmesh *out,
     if ((size_t)L->m[0] * 2 >= (1u << 21) || (size_t)L->m[1] * 2 >= (1u << 21) ||
         (size_t)L->m[2] * 2 >= (1u << 21))
         return POSE_ERR_INVALID_ARGUMENT;
+    for (int k = 0; k < 3; k++)
+        b.dn[k] = (size_t)L->m[k] + 1;
     b.lvl = malloc(n ? n : 1);
-    if (!b.lvl || initial_levels(&b, grading) != 0) {
+    b.dense = malloc(b.dn[0] * b.dn[1] * b.dn[2] * sizeof *b.dense);
+    if (!b.lvl || !b.dense || initial_levels(&b, grading) != 0) {
         free(b.lvl);
+        free(b.dense);
         return POSE_ERR_OUT_OF_MEMORY;
     }
+    memset(b.dense, 0xff, b.dn[0] * b.dn[1] * b.dn[2] * sizeof *b.dense);
     balance(&b);
 
     /* Phase A: leaf corners, so that edge midpoints can be looked up. */
@@ -378,8 +398,10 @@ pose_status pp_tet_octree_build(const pp_cells *L, int grading, pp_tetmesh *out,
         for (int y = 0; y < L->m[1]; y++)
             for (int x = 0; x < L->m[0]; x++) {
                 uint8_t l = level_at(&b, x, y, z);
+                if (l == NO_LEVEL)
+                    continue;
                 int s = 1 << l;
-                if (l == NO_LEVEL || (x | y | z) & (s - 1))
+                if ((x | y | z) & (s - 1))
                     continue;
                 for (int k = 0; k < 8; k++) {
                     int64_t p[3] = {2 * (int64_t)(x + (k & 1) * s), 2 * (int64_t)(y + (k >> 1 & 1) * s),
@@ -395,8 +417,10 @@ pose_status pp_tet_octree_build(const pp_cells *L, int grading, pp_tetmesh *out,
         for (int y = 0; y < L->m[1]; y++)
             for (int x = 0; x < L->m[0]; x++) {
                 uint8_t l = level_at(&b, x, y, z);
+                if (l == NO_LEVEL)
+                    continue;
                 int s = 1 << l;
-                if (l == NO_LEVEL || (x | y | z) & (s - 1))
+                if ((x | y | z) & (s - 1))
                     continue;
                 uint16_t label = (uint16_t)(pp_cells_at(L, x, y, z) - 1);
                 int64_t S = 2 * (int64_t)s, cell[3] = {x, y, z};
@@ -485,12 +509,13 @@ pose_status pp_tet_octree_build(const pp_cells *L, int grading, pp_tetmesh *out,
                 }
             }
     free(b.lvl);
-    size_t nv = b.vh.count;
+    size_t nv = b.nv;
     out->positions = malloc((nv ? nv : 1) * 3 * sizeof *out->positions);
     int8_t *dir = calloc(nv ? 3 * nv : 1, 1);
     if (b.oom || !out->positions || !dir || nv > UINT32_MAX) {
         free(b.vh.key);
         free(b.vh.val);
+        free(b.dense);
         free(b.tets);
         free(b.labels);
         free(of);
@@ -500,6 +525,17 @@ pose_status pp_tet_octree_build(const pp_cells *L, int grading, pp_tetmesh *out,
         return b.oom || !out->positions ? POSE_ERR_OUT_OF_MEMORY : POSE_ERR_INVALID_ARGUMENT;
     }
     const double hc = 0.5 * L->c;
+    for (size_t z = 0; z < b.dn[2]; z++)
+        for (size_t y = 0; y < b.dn[1]; y++)
+            for (size_t x = 0; x < b.dn[0]; x++) {
+                uint32_t v = b.dense[x + b.dn[0] * (y + b.dn[1] * z)];
+                if (v == UINT32_MAX)
+                    continue;
+                out->positions[3 * (size_t)v] = (float)(L->o[0] + (double)x * L->c);
+                out->positions[3 * (size_t)v + 1] = (float)(L->o[1] + (double)y * L->c);
+                out->positions[3 * (size_t)v + 2] = (float)(L->o[2] + (double)z * L->c);
+            }
+    free(b.dense);
     for (size_t i = 0; i < b.vh.cap; i++) {
         uint64_t k = b.vh.key[i];
         if (k == UINT64_MAX)

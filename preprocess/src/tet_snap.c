@@ -204,15 +204,10 @@ static void closest_on_tri(const double p[3], double v[3][3], double out[3])
         out[k] = v[0][k] + ab[k] * sv + ac[k] * tw;
 }
 
-/* Visit the triangles of the buckets within `reach` of p. */
-#define FOR_TRIANGLES_NEAR(g, p, reach, tvar)                                                 \
-    double lo_[3], hi_[3];                                                                    \
-    for (int k_ = 0; k_ < 3; k_++) {                                                          \
-        lo_[k_] = (p)[k_] - (reach);                                                          \
-        hi_[k_] = (p)[k_] + (reach);                                                          \
-    }                                                                                         \
+/* Visit the triangles of the buckets overlapping the box [lo, hi]. */
+#define FOR_TRIANGLES_IN(g, lo, hi, tvar)                                                     \
     int a_[3], z_[3];                                                                         \
-    bucket_range((g), lo_, hi_, a_, z_);                                                      \
+    bucket_range((g), (lo), (hi), a_, z_);                                                    \
     for (int bk_ = a_[2]; bk_ <= z_[2]; bk_++)                                                \
         for (int bj_ = a_[1]; bj_ <= z_[1]; bj_++)                                            \
             for (int bi_ = a_[0]; bi_ <= z_[0]; bi_++)                                        \
@@ -232,7 +227,11 @@ static int axis_hit(const pp_mesh *m, const buckets *g, const double p[3], int a
     int have = 0;
     uint32_t t;
     *best = INFINITY;
-    FOR_TRIANGLES_NEAR(g, p, reach, t)
+    /* only the buckets along the segment */
+    double lo[3] = {p[0], p[1], p[2]}, hi[3] = {p[0], p[1], p[2]};
+    lo[axis] -= reach;
+    hi[axis] += reach;
+    FOR_TRIANGLES_IN(g, lo, hi, t)
     {
         double v[3][3], s;
         tri_points(m, t, v);
@@ -244,13 +243,15 @@ static int axis_hit(const pp_mesh *m, const buckets *g, const double p[3], int a
     return have;
 }
 
-static int closest_point(const pp_mesh *m, const buckets *g, const double p[3], double reach,
-                         double out[3])
+static int closest_within(const pp_mesh *m, const buckets *g, const double p[3], double reach,
+                          double out[3])
 {
     double best = reach * reach;
     int have = 0;
     uint32_t t;
-    FOR_TRIANGLES_NEAR(g, p, reach, t)
+    double lo[3] = {p[0] - reach, p[1] - reach, p[2] - reach},
+           hi[3] = {p[0] + reach, p[1] + reach, p[2] + reach};
+    FOR_TRIANGLES_IN(g, lo, hi, t)
     {
         double v[3][3], cp[3], r[3];
         tri_points(m, t, v);
@@ -264,6 +265,16 @@ static int closest_point(const pp_mesh *m, const buckets *g, const double p[3], 
         }
     }
     return have;
+}
+
+/* Closest surface point within reach, looking near first (after the axis
+ * moves the point is usually on or next to the surface). */
+static int closest_point(const pp_mesh *m, const buckets *g, const double p[3], double reach,
+                         double out[3])
+{
+    if (closest_within(m, g, p, 0.25 * reach, out))
+        return 1;
+    return closest_within(m, g, p, reach, out);
 }
 
 /* Target of a boundary vertex p whose staircase faces point along the axes
@@ -329,7 +340,7 @@ pose_status pp_tet_snap(pp_tetmesh *t, const pp_mesh *surface, const int8_t *dir
     uint32_t *inc = malloc((start[nv] ? start[nv] : 1) * sizeof *inc);
     double *q0 = malloc((start[nv] ? start[nv] : 1) * sizeof *q0);
     buckets g = {0};
-    pose_status s = inc && q0 ? buckets_build(surface, reach, &g) : POSE_ERR_OUT_OF_MEMORY;
+    pose_status s = inc && q0 ? buckets_build(surface, 0.5 * reach, &g) : POSE_ERR_OUT_OF_MEMORY;
     if (s != POSE_OK) {
         free(start);
         free(inc);

@@ -197,6 +197,108 @@ static void test_lattice_budget(void **state)
     pp_mesh_free(&s);
 }
 
+
+typedef struct tri_key {
+    uint32_t v[3];
+} tri_key;
+
+static int cmp_tri(const void *a, const void *b)
+{
+    return memcmp(a, b, sizeof(tri_key));
+}
+
+/* Faces used by one tet (boundary); fails on a face used by three or more
+ * (a non-conforming mesh shows up as unmatched faces inside, counted too). */
+static size_t boundary_faces(const pp_tetmesh *t)
+{
+    size_t n = 4 * t->tet_count, b = 0;
+    tri_key *f = malloc(n * sizeof *f);
+    assert_non_null(f);
+    for (size_t i = 0; i < t->tet_count; i++)
+        for (int k = 0; k < 4; k++) {
+            int j = 0;
+            for (int q = 0; q < 4; q++)
+                if (q != k)
+                    f[4 * i + k].v[j++] = t->tets[4 * i + q];
+            for (int a = 0; a < 2; a++)
+                for (int c = 0; c < 2 - a; c++)
+                    if (f[4 * i + k].v[c] > f[4 * i + k].v[c + 1]) {
+                        uint32_t x = f[4 * i + k].v[c];
+                        f[4 * i + k].v[c] = f[4 * i + k].v[c + 1];
+                        f[4 * i + k].v[c + 1] = x;
+                    }
+        }
+    qsort(f, n, sizeof *f, cmp_tri);
+    for (size_t i = 0; i < n;) {
+        size_t j = i;
+        while (j < n && memcmp(&f[i], &f[j], sizeof *f) == 0)
+            j++;
+        assert_true(j - i <= 2);
+        b += j - i == 1;
+        i = j;
+    }
+    free(f);
+    return b;
+}
+
+static void test_graded_octree(void **state)
+{
+    (void)state;
+    char err[256] = "";
+    pp_mesh skin, bone;
+    float c[3] = {0, 0, 0};
+    shape_sphere(&skin, c, 0.1f, 3);
+    shape_cylinder(&bone, 0, 0, 0.02f, -0.06f, 0.06f, 24);
+    uint16_t lab = 2;
+    pp_voxels v;
+    const float h = 0.004f;
+    assert_int_equal(pp_voxelize(&skin, &bone, &lab, 1, h, &v, NULL, err, sizeof err), POSE_OK);
+    size_t body = 0;
+    for (size_t i = 0; i < (size_t)v.nx * v.ny * v.nz; i++)
+        body += v.labels[i] != 0;
+    pp_tet_options uo = {.no_snap = 1}, go = {.no_snap = 1, .grading = 3};
+    pp_tetmesh u, g;
+    pp_tet_quality uq, gq;
+    assert_int_equal(pp_tetrahedralize(&v, &skin, &uo, &u, &uq, err, sizeof err), POSE_OK);
+    assert_int_equal(pp_tetrahedralize(&v, &skin, &go, &g, &gq, err, sizeof err), POSE_OK);
+    /* same body, same staircase boundary (one-cell leaves there), fewer vertices */
+    double vol = check_mesh(&g, 3);
+    assert_near(vol, body * (double)h * h * h, 1e-9);
+    assert_int_equal(boundary_faces(&g), boundary_faces(&u));
+    assert_true(g.vertex_count < 0.8 * u.vertex_count);
+    /* transition tets: centre fans keep angles in 35-126 degrees */
+    assert_true(gq.min_dihedral_deg > 35.0);
+    assert_true(gq.max_dihedral_deg < 126.0);
+    assert_true(gq.max_radius_edge < 1.2);
+    assert_int_equal(gq.labels_lost, 0);
+    double bone_u = 0.0, bone_g = 0.0;
+    for (size_t i = 0; i < g.tet_count; i++) {
+        float cc[3];
+        centroid(&g, i, cc);
+        assert_int_equal(g.labels[i], pp_voxels_sample(&v, cc) - 1);
+        if (g.labels[i] == 3)
+            bone_g += pp_tet_volume(&g, i);
+    }
+    for (size_t i = 0; i < u.tet_count; i++)
+        if (u.labels[i] == 3)
+            bone_u += pp_tet_volume(&u, i);
+    assert_near(bone_g, bone_u, 1e-9);
+    pp_tetmesh_free(&g);
+    pp_tetmesh_free(&u);
+
+    /* snapped and on a budget */
+    go.no_snap = 0;
+    go.target_vertices = 6000;
+    assert_int_equal(pp_tetrahedralize(&v, &skin, &go, &g, &gq, err, sizeof err), POSE_OK);
+    assert_near((double)g.vertex_count, 6000.0, 0.1 * 6000);
+    vol = check_mesh(&g, 3);
+    assert_near(vol, pp_mesh_volume(&skin), 0.03 * pp_mesh_volume(&skin));
+    pp_tetmesh_free(&g);
+    pp_voxels_free(&v);
+    pp_mesh_free(&bone);
+    pp_mesh_free(&skin);
+}
+
 #ifdef POSE_HAVE_TETGEN
 static void test_box_tetgen(void **state)
 {
@@ -250,6 +352,7 @@ int main(void)
         cmocka_unit_test(test_box_lattice),
         cmocka_unit_test(test_lattice_follows_voxels),
         cmocka_unit_test(test_lattice_budget),
+        cmocka_unit_test(test_graded_octree),
 #ifdef POSE_HAVE_TETGEN
         cmocka_unit_test(test_box_tetgen),
         cmocka_unit_test(test_tetgen_labels),
