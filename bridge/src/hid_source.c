@@ -29,6 +29,7 @@ typedef struct hid_source {
     uint8_t report[PB_HID_MAX_REPORT_BYTES + 1];
     size_t report_len;
     pb_hid_source_stats stats;
+    long hold;              /* hold-pose channel, -1 for none */
     FILE *record;
     int64_t record_t0;
 } hid_source;
@@ -111,7 +112,10 @@ pose_status pb_hid_source_create(pb_hid_transport *t, const pb_hid_source_option
     } else if (err) {
         *err = absent;
     }
-    s->opt.expected_desc = NULL; /* not kept: the caller's buffer may go away */
+    s->opt.expected_desc = NULL; /* not kept: the caller's buffers may go away */
+    const char *hold_name = s->opt.hold_channel;
+    s->opt.hold_channel = NULL;
+    s->hold = -1;
     if (st == POSE_OK) {
         s->desc_len = len;
         st = pb_hid_desc_parse(s->desc_bytes, len, t->origin, &s->desc, err);
@@ -134,6 +138,16 @@ pose_status pb_hid_source_create(pb_hid_transport *t, const pb_hid_source_option
     }
     memcpy(s->base.channels, s->desc->channels, s->desc->channel_count * sizeof *s->base.channels);
     s->base.channel_count = s->desc->channel_count;
+    if (hold_name) {
+        s->hold = pb_source_find_channel(&s->base, hold_name);
+        if (s->hold < 0) {
+            pose_status bad = pb_fail(err, POSE_ERR_NOT_FOUND, "%s: no channel '%s' to hold the pose with",
+                                      t->origin, hold_name);
+            hid_close(&s->base);
+            free(s);
+            return bad;
+        }
+    }
     for (size_t i = 0; i < s->desc->channel_count; i++)
         s->values[i] = NAN;
     s->base.state = waiting_for_device ? PB_SOURCE_DISCONNECTED : PB_SOURCE_WAITING;
@@ -178,8 +192,9 @@ static void fault(hid_source *s, pb_hid_decode_result r)
 static int deliver(hid_source *s, pb_update *out, int64_t t_ns, uint32_t first, uint32_t count)
 {
     size_t n = 0;
+    int held = s->hold >= 0 && s->valid[s->hold] && s->values[s->hold] != 0.0;
     for (uint32_t c = first; c < first + count; c++) {
-        if (!s->valid[c])
+        if (!s->valid[c] || (held && s->base.channels[c].unit[0]))
             continue;
         s->out_channels[n] = c;
         s->out_values[n++] = s->values[c];

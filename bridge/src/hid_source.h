@@ -70,6 +70,13 @@ typedef struct pb_hid_source_options {
      */
     const uint8_t *expected_desc;
     size_t expected_desc_len;
+    /**
+     * A channel that freezes the pose while it reads non-zero (the
+     * mannequin's "hold pose" button, "Button.1"), or NULL. While held,
+     * updates carry only channels without a unit (buttons, counters), so a
+     * mapping keeps the joints where they were; the angles resume on release.
+     */
+    const char *hold_channel;
 } pb_hid_source_options;
 
 /** Counters since creation. */

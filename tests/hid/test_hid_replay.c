@@ -265,6 +265,39 @@ static void test_expected_descriptor(void **state)
     assert_non_null(strstr(err.message, "not present"));
 }
 
+/* The mannequin's hold button freezes the angles: updates carry only the
+ * button and the counter while it is pressed (3.2 to 3.8 s of the arm raise). */
+static void test_hold_pose(void **state)
+{
+    (void)state;
+    pb_hid_replay_options opt = {.as_fast_as_possible = 1, .source = {.hold_channel = "Button.1"}};
+    pb_source *src = open_replay("mannequin_arm_raise.hid", &opt);
+    pb_update u;
+    int held = 0, free_running = 0;
+    while (pb_source_read(src, &u, 100) == 1) {
+        if (u.count == 2) {
+            assert_int_equal(u.channels[0], 16);
+            assert_true(u.values[0] == 1.0);
+            assert_int_equal(u.channels[1], 17);
+            long n = (long)u.values[1];
+            assert_true(n >= 800 && n < 950); /* 3.2 s .. 3.8 s at 250 Hz */
+            held++;
+        } else {
+            assert_int_equal(u.count, 18);
+            free_running++;
+        }
+    }
+    assert_int_equal(held, 150);
+    assert_int_equal(free_running, 2500 - 150);
+    pb_source_destroy(src);
+    char path[1024];
+    data_path(path, sizeof path, "mannequin_arm_raise.hid");
+    opt.source.hold_channel = "Button.9";
+    pb_error err;
+    assert_int_equal(pb_hid_open(path, &opt, &src, &err), POSE_ERR_NOT_FOUND);
+    assert_non_null(strstr(err.message, "Button.9"));
+}
+
 static void test_seek_and_loop(void **state)
 {
     (void)state;
@@ -294,6 +327,7 @@ int main(void)
         cmocka_unit_test(test_decode_matches_generator),
         cmocka_unit_test(test_faults),
         cmocka_unit_test(test_expected_descriptor),
+        cmocka_unit_test(test_hold_pose),
         cmocka_unit_test(test_seek_and_loop),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
