@@ -95,6 +95,8 @@ typedef struct bake_state {
     pp_voxels vox;
     pp_tetmesh tet;
     pp_weights w;
+    pp_tetmesh rigid;      /* shallow copy of tet with rigid_labels */
+    uint16_t *rigid_labels;
     pp_tet_hash *hash;
     uint32_t **emb_tet;   /* per tissue */
     float **emb_bary;
@@ -119,6 +121,7 @@ static void bake_state_free(bake_state *s, const pp_bake_options *o, size_t tiss
     pp_tetmesh_free(&s->tet);
     pp_weights_free(&s->w);
     pp_tet_hash_free(s->hash);
+    free(s->rigid_labels);
     for (size_t i = 0; i < tissue_count; i++) {
         if (s->emb_tet)
             free(s->emb_tet[i]);
@@ -187,8 +190,23 @@ static int build_tissues(const pp_bake_options *o, bake_state *s, pp_bake_report
     if (!rep->tissues || !s->emb_tet || !s->emb_bary || !s->tissues)
         return fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
     rep->tissue_count = nt;
+    /* Bones embed in tets that move rigidly with their joint: labelled with
+     * it and with weight exactly 1 at all four corners. A bone tet touching
+     * another bone (a shared, reassigned corner) would bend the bone. */
+    s->rigid_labels = malloc((s->tet.tet_count ? s->tet.tet_count : 1) * sizeof *s->rigid_labels);
+    if (!s->rigid_labels)
+        return fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+    for (size_t t = 0; t < s->tet.tet_count; t++) {
+        uint16_t lab = s->tet.labels[t];
+        for (int c = 0; lab && c < 4; c++)
+            if (pp_weights_get(&s->w, s->tet.tets[4 * t + c], lab - 1u) != 1.0f)
+                lab = 0;
+        s->rigid_labels[t] = lab;
+    }
+    s->rigid = s->tet;
+    s->rigid.labels = s->rigid_labels;
     char herr[256];
-    int rc = pp_tet_hash_build(&s->tet, 0, &s->hash, herr, sizeof herr);
+    int rc = pp_tet_hash_build(&s->rigid, 0, &s->hash, herr, sizeof herr);
     if (rc < 0)
         return fail(err, n, rc, "%s", herr);
     int threads = o->threads > 0 ? o->threads : 1;
