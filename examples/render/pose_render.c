@@ -335,6 +335,8 @@ typedef struct summary {
     int first;
     double apply_ms, render_ms;
     int images;
+    int total;    /* images this run will write, for the progress line */
+    double start; /* ex_now() at the first image */
 } summary;
 
 static int emit(summary *s, const ex_image *img, const char *path, long frame, const char *method,
@@ -352,11 +354,18 @@ static int emit(summary *s, const ex_image *img, const char *path, long frame, c
         fprintf(s->json, ", \"frame\": %ld, \"method\": \"%s\", \"coverage\": %.4f, \"apply_ms\": %.3f}", frame,
                 method, cov, apply_ms);
         s->first = 0;
-    } else {
-        printf("wrote %s (%dx%d, %s, %.1f%% covered)\n", path, img->width, img->height, method, 100.0 * cov);
     }
-    if (isatty(STDERR_FILENO))
-        fprintf(stderr, "\rpose-render: %d image(s)", s->images);
+    /* Progress: in the text output's own lines, or on stderr beside JSON when it is a terminal. */
+    double el = ex_now() - s->start, eta = el / s->images * (s->total - s->images);
+    char progress[64] = "";
+    if (s->total > 1)
+        snprintf(progress, sizeof progress, " [%d/%d, %.0f%%, ETA %.0f s]", s->images, s->total,
+                 100.0 * s->images / s->total, eta);
+    if (!s->json)
+        printf("wrote %s (%dx%d, %s, %.1f%% covered)%s\n", path, img->width, img->height, method, 100.0 * cov,
+               progress);
+    else if (isatty(STDERR_FILENO) && s->total > 1)
+        fprintf(stderr, "\r\033[Kpose-render:%s", progress);
     return 0;
 }
 
@@ -517,6 +526,8 @@ static int run(const options *o, summary *s, char *err, size_t err_size)
         goto done;
     }
     int many = (motion && !o->compare) || o->turntable;
+    s->total = motion && !o->compare ? (int)o->frame_count : o->turntable ? o->turntable : 1;
+    s->start = ex_now();
     const char *out = o->output ? o->output : many ? "render" : "pose.png";
     if (many && make_dir(out, err, err_size) < 0)
         goto done;
@@ -628,7 +639,7 @@ int main(int argc, char **argv)
         fprintf(s.json, ",\n  \"width\": %d, \"height\": %d,\n  \"images\": [", o.width, o.height);
     }
     int rc = run(&o, &s, err, sizeof err);
-    if (isatty(STDERR_FILENO) && s.images)
+    if (s.json && isatty(STDERR_FILENO) && s.total > 1 && s.images)
         fputc('\n', stderr);
     if (s.json) {
         fprintf(s.json, "\n  ],\n  \"ok\": %s", rc == 0 ? "true" : "false");
