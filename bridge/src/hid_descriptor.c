@@ -42,8 +42,7 @@ typedef struct usage_range {
 } usage_range;
 
 typedef struct parser {
-    const uint8_t *bytes;
-    size_t len, pos;
+    size_t pos;
     const char *origin;
     pb_error *err;
     pose_status status;
@@ -431,8 +430,6 @@ static int local_item(parser *p, uint32_t tag, uint32_t u, size_t size)
     }
 }
 
-static void usage_label(uint32_t usage, char *buf, size_t size);
-
 /* Channels: decodable, non-constant input fields, grouped by report ID. */
 static int build_channels(parser *p)
 {
@@ -475,10 +472,10 @@ static int build_channels(parser *p)
         pb_channel *ch = &d->channels[c];
         char base[48];
         if (f->flags & PB_HID_VARIABLE) {
-            usage_label(f->usage, base, sizeof base);
+            pb_hid_usage_name(f->usage, base, sizeof base);
         } else {
             char page[32];
-            usage_label(f->usage & 0xFFFF0000u, page, sizeof page);
+            pb_hid_usage_name(f->usage & 0xFFFF0000u, page, sizeof page);
             char *dot = strchr(page, '.');
             if (dot)
                 *dot = '\0';
@@ -519,8 +516,6 @@ pose_status pb_hid_desc_parse(const uint8_t *bytes, size_t len, const char *orig
     parser *p = calloc(1, sizeof *p);
     if (!p)
         return pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "%s: report descriptor: out of memory", origin);
-    p->bytes = bytes;
-    p->len = len;
     p->origin = origin;
     p->err = err;
     p->d = calloc(1, sizeof *p->d);
@@ -658,11 +653,6 @@ static const char *lookup(const named *t, size_t n, uint32_t id)
         if (t[i].id == id)
             return t[i].name;
     return NULL;
-}
-
-static void usage_label(uint32_t usage, char *buf, size_t size)
-{
-    pb_hid_usage_name(usage, buf, size);
 }
 
 const char *pb_hid_usage_name(uint32_t usage, char *buf, size_t size)

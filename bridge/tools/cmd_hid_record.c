@@ -103,8 +103,8 @@ static int run(int argc, char **argv)
         if (tty && now - last_progress > 250000000) {
             last_progress = now;
             if (seconds > 0)
-                fprintf(stderr, "\rrecording: %ld reports, %.1f / %.1f s (%.0f%%)", reports, el, seconds,
-                        100.0 * el / seconds);
+                fprintf(stderr, "\rrecording: %ld reports, %.1f / %.1f s (%.0f%%, ETA %.0f s)", reports, el,
+                        seconds, 100.0 * el / seconds, seconds > el ? seconds - el : 0.0);
             else
                 fprintf(stderr, "\rrecording: %ld reports, %.1f s", reports, el);
         }
