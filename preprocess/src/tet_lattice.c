@@ -149,8 +149,10 @@ pose_status pp_tet_lattice(const pp_voxels *vox, const pp_mesh *skin, const pp_t
     pp_tet_options def = {0};
     if (!opt)
         opt = &def;
-    int grading = opt->grading < 0 ? 0 : opt->grading > PP_TET_MAX_GRADING ? PP_TET_MAX_GRADING
-                                                                           : opt->grading;
+    int grading = opt->grading < 0    ? 0
+                  : opt->grading == 0 ? PP_TET_DEFAULT_GRADING
+                  : opt->grading > PP_TET_MAX_GRADING ? PP_TET_MAX_GRADING
+                                                      : opt->grading;
     size_t body = 0, nvox = (size_t)vox->nx * vox->ny * vox->nz;
     for (size_t i = 0; i < nvox; i++)
         body += vox->labels[i] != PP_VOXEL_OUTSIDE;

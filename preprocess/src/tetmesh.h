@@ -2,11 +2,12 @@
  *
  * Tetrahedralize the labelled body. Two backends behind one call:
  *
- *  - PP_TET_LATTICE (built in, Apache-2.0, the default): a Kuhn
- *    (Freudenthal) lattice of the voxel image, every body cell split into
- *    six congruent tets along its main diagonal, or with opt->grading > 0 a
- *    balanced octree that is one cell fine along skin and bone boundaries
- *    and coarser inside. The outer boundary vertices are then snapped onto
+ *  - PP_TET_LATTICE (built in, Apache-2.0, the default): a balanced octree
+ *    over the voxel image, one cell fine along skin and bone boundaries and
+ *    up to 2^grading cells wide inside; regular regions are Kuhn
+ *    (Freudenthal) cubes (six congruent tets around the main diagonal),
+ *    transitions are fans from cell and face centres. grading < 0 gives the
+ *    uniform Kuhn lattice. The outer boundary vertices are then snapped onto
  *    the skin surface (a move is backed off when an incident tet would
  *    become a sliver, so nothing inverts). Tet labels are the cells' voxel
  *    labels. The size budget picks the cell size.
@@ -29,6 +30,7 @@
 #include <pose/pose.h>
 
 #define PP_TET_MAX_GRADING 4
+#define PP_TET_DEFAULT_GRADING 3
 
 typedef enum pp_tet_backend {
     PP_TET_DEFAULT = 0, /**< the built-in lattice */
@@ -42,8 +44,9 @@ typedef struct pp_tet_options {
     size_t target_vertices;  /**< size budget; 0: lattice = voxel grid, TetGen = its own sizing */
     double max_radius_edge;  /**< TetGen -q bound (default 1.414) */
     int grading;             /**< lattice: octree levels of coarsening away from skin and bone
-                                  boundaries (0: uniform Kuhn lattice; 1..PP_TET_MAX_GRADING:
-                                  leaves up to 2^grading cells wide) */
+                                  boundaries, leaves up to 2^grading cells wide (0: default,
+                                  PP_TET_DEFAULT_GRADING; 1..PP_TET_MAX_GRADING; negative:
+                                  uniform Kuhn lattice, one cell per leaf everywhere) */
     int no_snap;             /**< keep the staircase boundary (for tests) */
     int verbose;             /**< TetGen: print its own log to stdout */
 } pp_tet_options;

@@ -135,8 +135,8 @@ static void test_lattice_follows_voxels(void **state)
     for (size_t i = 0; i < (size_t)v.nx * v.ny * v.nz; i++)
         body += v.labels[i] != 0;
 
-    /* unsnapped: one cell per voxel, six congruent Kuhn tets each */
-    pp_tet_options o = {.no_snap = 1};
+    /* uniform, unsnapped: one cell per voxel, six congruent Kuhn tets each */
+    pp_tet_options o = {.no_snap = 1, .grading = -1};
     pp_tetmesh t;
     pp_tet_quality q;
     assert_int_equal(pp_tetrahedralize(&v, &skin, &o, &t, &q, err, sizeof err), POSE_OK);
@@ -159,7 +159,8 @@ static void test_lattice_follows_voxels(void **state)
     pp_tetmesh_free(&t);
 
     /* snapped: volume of the cylinder (polygon prism), bone tets unchanged */
-    assert_int_equal(pp_tetrahedralize(&v, &skin, NULL, &t, &q, err, sizeof err), POSE_OK);
+    o.no_snap = 0;
+    assert_int_equal(pp_tetrahedralize(&v, &skin, &o, &t, &q, err, sizeof err), POSE_OK);
     double prism = pp_mesh_volume(&skin);
     vol = check_mesh(&t, 5);
     assert_near(vol, prism, 0.01 * prism);
@@ -256,7 +257,7 @@ static void test_graded_octree(void **state)
     size_t body = 0;
     for (size_t i = 0; i < (size_t)v.nx * v.ny * v.nz; i++)
         body += v.labels[i] != 0;
-    pp_tet_options uo = {.no_snap = 1}, go = {.no_snap = 1, .grading = 3};
+    pp_tet_options uo = {.no_snap = 1, .grading = -1}, go = {.no_snap = 1}; /* default grading */
     pp_tetmesh u, g;
     pp_tet_quality uq, gq;
     assert_int_equal(pp_tetrahedralize(&v, &skin, &uo, &u, &uq, err, sizeof err), POSE_OK);
