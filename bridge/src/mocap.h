@@ -65,7 +65,10 @@ pose_status pb_asf_load(const char *path, pb_clip **out, pb_error *err);
 pose_status pb_amc_parse(pb_clip *clip, const char *text, size_t size, const char *name, pb_error *err);
 pose_status pb_amc_load(pb_clip *clip, const char *path, pb_error *err);
 
-/** Load by extension: .bvh, or .amc with `skeleton` naming its .asf. */
+/**
+ * Load by extension: .bvh, .asf (no frames), or .amc with `skeleton` naming
+ * its .asf (NULL: the CMU-style sibling "<subject>.asf" of "<subject>_<take>.amc").
+ */
 pose_status pb_clip_load(const char *path, const char *skeleton, pb_clip **out, pb_error *err);
 
 /** Free a clip; NULL is a no-op. */

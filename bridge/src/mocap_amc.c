@@ -192,14 +192,36 @@ static int has_suffix(const char *s, const char *suf)
     return 1;
 }
 
+/* CMU naming: "dir/01_01.amc" -> "dir/01.asf" (the subject's skeleton) */
+static int sibling_asf(const char *amc, char *out, size_t size)
+{
+    int n = snprintf(out, size, "%s", amc);
+    if (n < 0 || (size_t)n >= size)
+        return -1;
+    char *slash = strrchr(out, '/');
+    char *us = strchr(slash ? slash + 1 : out, '_');
+    if (!us || (size_t)(us - out) + 5 > size)
+        return -1;
+    memcpy(us, ".asf", 5);
+    FILE *f = fopen(out, "rb");
+    if (!f)
+        return -1;
+    fclose(f);
+    return 0;
+}
+
 pose_status pb_clip_load(const char *path, const char *skeleton, pb_clip **out, pb_error *err)
 {
     if (!out || !path)
         return pb_fail(err, POSE_ERR_INVALID_ARGUMENT, "pb_clip_load: NULL argument");
     *out = NULL;
+    char found[1024];
+    if (has_suffix(path, ".amc") && !skeleton && sibling_asf(path, found, sizeof found) == 0)
+        skeleton = found;
     if (has_suffix(path, ".amc") || skeleton) {
         if (!skeleton)
-            return pb_fail(err, POSE_ERR_INVALID_ARGUMENT, "%s: an AMC file needs its ASF skeleton (--skeleton)", path);
+            return pb_fail(err, POSE_ERR_INVALID_ARGUMENT,
+                           "%s: an AMC file needs its ASF skeleton (--skeleton; none found beside it)", path);
         pb_clip *c;
         pose_status s = pb_asf_load(skeleton, &c, err);
         if (s)

@@ -11,7 +11,7 @@
 static void help(FILE *f)
 {
     fprintf(f, "usage: pose-bridge fk FILE [--skeleton ASF] [--frames 0,1,100] [--json]\n"
-               "  FILE        a .bvh file, or an .amc file with --skeleton\n"
+               "  FILE        a .bvh file, or an .amc file (its ASF: --skeleton, or NN.asf beside NN_MM.amc)\n"
                "  --frames    comma-separated frame indices (0-based; default 0)\n"
                "  --json      machine-readable output\n"
                "Prints the world position of every joint and end site at each frame,\n"

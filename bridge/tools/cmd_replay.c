@@ -17,7 +17,7 @@ static void help(FILE *f)
 {
     fprintf(f,
             "usage: pose-bridge replay CLIP [--skeleton ASF] --rig RIG [--map MAP] [options]\n"
-            "  CLIP            .bvh, or .amc with --skeleton\n"
+            "  CLIP            .bvh, or .amc (ASF from --skeleton, or NN.asf beside NN_MM.amc)\n"
             "  --rig RIG       a .rig file (poses a pose_state and runs pose_apply each host frame),\n"
             "                  a .bvh/.asf whose skeleton is the rig, or 'self' (the clip's own skeleton)\n"
             "  --map MAP       mapping JSON (default: joints of the same name)\n"

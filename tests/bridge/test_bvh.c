@@ -161,6 +161,13 @@ static void test_missing_file(void **state)
     assert_non_null(strstr(err.message, "/nonexistent/dir/x.bvh: cannot open"));
     assert_int_equal(pb_clip_load("/nonexistent.amc", NULL, &clip, &err), POSE_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(err.message, "needs its ASF skeleton"));
+    /* the CMU sibling skeleton is found by name */
+    char amc[1024];
+    if (pb_clip_load(BT_DATA(amc, "mocap/cmu-asf-amc/11_01.amc"), NULL, &clip, &err) != POSE_OK)
+        fail_msg("%s", err.message);
+    assert_string_equal(clip->format, "asf-amc");
+    assert_true(clip->frame_count > 0);
+    pb_clip_free(clip);
 }
 
 static void fk(const pb_clip *c, size_t f, double (*wp)[3])
