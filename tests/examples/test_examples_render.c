@@ -197,6 +197,56 @@ static void test_view_under_xvfb(void **state)
     assert_non_null(strstr(out, "method CoR"));
 }
 
+/* The viewer driven live by recorded devices through the bridge's thread: poses arrive. */
+static void test_view_live_sources(void **state)
+{
+    (void)state;
+    char log[2400];
+    snprintf(log, sizeof log, "%s/xvfb_live.log", tmp);
+    if (!strcmp(view_bin, "-") || run(log, "command -v xvfb-run") != 0)
+        skip();
+    assert_int_equal(run(log, "'%s' --help", render_bin), 0);
+    if (strstr(slurp(log), "built without the bridge"))
+        skip();
+    const char *data = getenv("POSE_DATA_DIR");
+    assert_non_null(data);
+    static const char *sources[3][2] = {
+        {"hid/mannequin_arm_raise.hid", "hid_mannequin_bar.json"},
+        {"can-rig/sit_stand_arm_raise.log", "can_rig_bar.json"},
+        {"mocap/cmu-bvh/131_01.bvh", "cmu131_arm_to_bar.json"},
+    };
+    for (int i = 0; i < 3; i++) {
+        /* bar_map lives in bridge/maps/; its siblings are the other mappings. */
+        char maps[2048];
+        snprintf(maps, sizeof maps, "%s", bar_map);
+        char *slash = strrchr(maps, '/');
+        assert_non_null(slash);
+        *slash = '\0';
+        assert_int_equal(run(log,
+                             "ASAN_OPTIONS=\"${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0\" "
+                             "xvfb-run -a -s '-screen 0 640x480x24' '%s' '%s' --size 200x150 --quit-after 40 "
+                             "--source '%s/%s' --map '%s/%s'",
+                             view_bin, bar, data, sources[i][0], maps, sources[i][1]),
+                         0);
+        const char *out = slurp(log);
+        printf("%s", out);
+        const char *src = strstr(out, ", source ");
+        assert_non_null(src);
+        /* Clips report the frame reached, devices the poses received: either way not zero. */
+        const char *frame = strstr(src, "frame "), *poses = strstr(src, " poses");
+        if (i == 2) {
+            assert_non_null(frame);
+            assert_true(atol(frame + 6) > 0);
+        } else {
+            assert_non_null(poses);
+            const char *p = poses;
+            while (p > src && p[-1] >= '0' && p[-1] <= '9')
+                p--;
+            assert_true(atol(p) > 0);
+        }
+    }
+}
+
 /* ---------------------------------------------------------------- images */
 
 static void test_rest_image_not_blank(void **state)
@@ -491,6 +541,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_broken_source),
         cmocka_unit_test(test_view_without_display),
         cmocka_unit_test(test_view_under_xvfb),
+        cmocka_unit_test(test_view_live_sources),
         cmocka_unit_test(test_rest_image_not_blank),
         cmocka_unit_test(test_silhouette_follows_pose),
         cmocka_unit_test(test_silhouette_follows_replay),
