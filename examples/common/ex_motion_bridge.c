@@ -12,7 +12,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "bridge_apply.h"
 #include "can_bus.h"
@@ -48,32 +47,10 @@ static int ends_with(const char *s, const char *suffix)
     return n >= m && !strcmp(s + n - m, suffix);
 }
 
-/* An AMC file's skeleton: the ASF beside it named by the subject ("01_01.amc" -> "01.asf"). */
-static int find_asf(const char *amc, char *out, size_t out_size)
-{
-    struct stat sb;
-    snprintf(out, out_size, "%s", amc);
-    char *slash = strrchr(out, '/');
-    char *base = slash ? slash + 1 : out;
-    char *us = strchr(base, '_');
-    if (!us)
-        return -1;
-    snprintf(us, out_size - (size_t)(us - out), ".asf");
-    return stat(out, &sb) == 0 ? 0 : -1;
-}
-
 static int open_clip(ex_motion *m, const char *source, pb_error *pe, char *err, size_t err_size)
 {
-    char asf[4096];
-    const char *skeleton = NULL;
-    if (ends_with(source, ".amc")) {
-        if (find_asf(source, asf, sizeof asf) < 0) {
-            snprintf(err, err_size, "%s: no skeleton file beside it (expected %s)", source, asf);
-            return -1;
-        }
-        skeleton = asf;
-    }
-    if (pb_clip_load(source, skeleton, &m->clip, pe) < 0 || pb_retarget_create(m->map, m->clip, m->skel, &m->rt, pe) < 0)
+    /* An .amc finds its CMU skeleton (01_01.amc -> 01.asf) beside it: the bridge looks. */
+    if (pb_clip_load(source, NULL, &m->clip, pe) < 0 || pb_retarget_create(m->map, m->clip, m->skel, &m->rt, pe) < 0)
         return -1;
     if (m->clip->frame_count == 0) {
         snprintf(err, err_size, "%s: the clip has no frames", source);
