@@ -341,11 +341,15 @@ const pb_can_filter *pb_can_decoder_filters(const pb_can_decoder *d, size_t *cou
     return d->filters;
 }
 
-static void touch(can_node *n, int64_t t)
+/* A data frame from n at t. A CANopen node whose heartbeat is overdue
+ * stays silent: its PDOs alone would flip it back and forth every frame. */
+static void touch(const pb_can_decoder *d, can_node *n, int64_t t)
 {
     n->last_ns = t;
     n->frames++;
-    n->state = PB_CAN_NODE_ALIVE;
+    const int64_t hb = n->last_hb_ns == INT64_MIN ? d->first_ns : n->last_hb_ns;
+    if (!n->hb_timeout_ns || t - hb <= n->hb_timeout_ns)
+        n->state = PB_CAN_NODE_ALIVE;
 }
 
 static size_t feed_dbc(pb_can_decoder *d, can_node *n, const pb_can_frame *f)
@@ -491,7 +495,7 @@ size_t pb_can_decoder_feed(pb_can_decoder *d, const pb_can_frame *f, pb_update *
         case NODE_J1939: k = feed_j1939(d, n, f); break;
         }
         if (!heartbeat)
-            touch(n, f->t_ns);
+            touch(d, n, f->t_ns);
         else
             n->frames++;
         if (k)

@@ -152,6 +152,11 @@ static void test_decoder_canopen_j1939(void **state)
     assert_int_equal(pb_can_decoder_health(dec, &st, msg, sizeof msg), 1);
     assert_int_equal(st, PB_SOURCE_STALE);
     assert_non_null(strstr(msg, "WRIST_L: heartbeat lost"));
+    /* its PDOs alone do not bring it back */
+    f = frame(162, 0x1A1, 0, pos, 4);
+    assert_int_equal(pb_can_decoder_feed(dec, &f, &u), 1);
+    assert_int_equal(pb_can_decoder_health(dec, &st, msg, sizeof msg), 0);
+    assert_int_equal(st, PB_SOURCE_STALE);
     pb_can_node_info info;
     pb_can_decoder_node(dec, 0, &info);
     assert_int_equal(info.state, PB_CAN_NODE_SILENT);
@@ -163,14 +168,14 @@ static void test_decoder_canopen_j1939(void **state)
     assert_int_equal(pb_can_decoder_health(dec, &st, msg, sizeof msg), 1);
     assert_int_equal(st, PB_SOURCE_OK);
     assert_non_null(strstr(msg, "CANopen node 33 (WRIST_L): boot-up"));
-    /* the data stopped at 140 ms: silent after the timeouts (HEAD 3 x 10 ms, the others 50 ms) */
+    /* TRUNK and HEAD stopped at 140 ms: silent after their timeouts (3 x 10 ms, 50 ms) */
     pb_can_decoder_tick(dec, 175000000);
     pb_can_decoder_health(dec, &st, msg, sizeof msg);
     assert_int_equal(st, PB_SOURCE_STALE);
     assert_non_null(strstr(msg, "HEAD silent; 1 node(s)"));
     pb_can_decoder_tick(dec, 195000000);
     pb_can_decoder_health(dec, &st, msg, sizeof msg);
-    assert_non_null(strstr(msg, "3 node(s) silent")); /* WRIST_L's last TPDO was at 140 ms too */
+    assert_non_null(strstr(msg, "2 node(s) silent")); /* TRUNK, HEAD; WRIST_L spoke at 162 ms */
     f = frame(196, 0x1A8, 0, slope, 4);
     pb_can_decoder_feed(dec, &f, &u);
     f = frame(196, 0x0CF01390, 1, ssi, 8);
