@@ -1,0 +1,28 @@
+/* SPDX-License-Identifier: Apache-2.0
+ * libFuzzer harness for the skeleton template reader. */
+#include <stdint.h>
+#include <string.h>
+
+#include "template_json.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    pp_template t;
+    char err[512];
+    if (pp_template_parse((const char *)data, size, "fuzz.json", &t, err, sizeof err) == POSE_OK) {
+        /* Exercise the lookups on whatever was accepted. */
+        for (size_t i = 0; i < t.joint_count; i++) {
+            if (pp_template_find_joint(&t, t.joints[i].name) != (int)i)
+                __builtin_trap();
+            for (size_t b = 0; b < t.joints[i].bone_count; b++)
+                if (pp_template_joint_of_bone(&t, t.joints[i].bones[b]) != (int)i)
+                    __builtin_trap();
+        }
+    } else if (err[0] == '\0' || !strstr(err, "fuzz.json")) {
+        __builtin_trap(); /* every failure names the source */
+    }
+    pp_template_free(&t);
+    return 0;
+}

@@ -1,0 +1,173 @@
+/* SPDX-License-Identifier: Apache-2.0
+ * Skeleton templates: every malformed input is refused with a message that
+ * names the file, the line and what is wrong; the shipped template reads. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "template_json.h"
+
+#define HEAD "{\"format\": \"pose-skeleton-template\", \"version\": 1, \"joints\": [\n"
+#define ROOT "{\"name\": \"pelvis\", \"parent\": null, \"rule\": \"root\", \"bones\": [\"p\"]}"
+
+typedef struct bad_case {
+    const char *text;
+    int status;
+    const char *message; /* expected substring */
+} bad_case;
+
+static void test_rejects_malformed(void **state)
+{
+    (void)state;
+    static const bad_case cases[] = {
+        {"", POSE_ERR_FORMAT, "t.json: line 1 (offset 0): not valid JSON"},
+        {"{\"format\": \"pose-skeleton-template\",\n \"version\": 1,\n \"joints\": [}", POSE_ERR_FORMAT,
+         "t.json: line 3"},
+        {"[]", POSE_ERR_FORMAT, "top level must be an object"},
+        {"{\"format\": \"other\", \"version\": 1}", POSE_ERR_FORMAT, "'format' must be"},
+        {"{\"format\": \"pose-skeleton-template\", \"version\": 2}", POSE_ERR_VERSION, "'version' must be 1"},
+        {HEAD "]}", POSE_ERR_FORMAT, "'joints' must be a non-empty array"},
+        {"{\"format\": \"pose-skeleton-template\", \"version\": 1, \"jionts\": []}", POSE_ERR_FORMAT,
+         "unknown top-level key 'jionts'"},
+        {HEAD "{\"parent\": null}]}", POSE_ERR_FORMAT, "joints[0]: 'name' must be"},
+        {HEAD "{\"name\": \"pelvis\", \"rule\": \"root\"}]}", POSE_ERR_FORMAT,
+         "t.json:2: joint 'pelvis': missing or empty 'bones'"},
+        {HEAD "{\"name\": \"pelvis\", \"bones\": [\"p\"]}]}", POSE_ERR_FORMAT, "joint 'pelvis': missing 'rule'"},
+        {HEAD "{\"name\": \"pelvis\", \"rule\": \"ballz\", \"bones\": [\"p\"]}]}", POSE_ERR_FORMAT,
+         "'rule' must be one of root, ball, hinge, spine, fixed"},
+        {HEAD ROOT ",\n{\"name\": \"knee\", \"parent\": \"hip\", \"rule\": \"hinge\", \"bones\": [\"t\"]}]}",
+         POSE_ERR_INVALID_DATA, "t.json:3: joint 'knee': parent 'hip' is not a joint listed before this one"},
+        {HEAD ROOT ",\n{\"name\": \"pelvis\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"]}]}",
+         POSE_ERR_INVALID_DATA, "joint 'pelvis': name used twice"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"p\"]}]}",
+         POSE_ERR_INVALID_DATA, "joint 'hip': bone 'p' is already in joint 'pelvis'"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\", \"f\"]}]}",
+         POSE_ERR_INVALID_DATA, "'bones' lists 'f' twice"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"root\", \"bones\": [\"f\"]}]}",
+         POSE_ERR_INVALID_DATA, "rule 'root' is only for a joint without parent"},
+        {HEAD "{\"name\": \"pelvis\", \"parent\": null, \"rule\": \"ball\", \"bones\": [\"p\"]}]}",
+         POSE_ERR_INVALID_DATA, "a joint without parent must have rule 'root'"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"fixed\", \"bones\": [\"f\"]}]}",
+         POSE_ERR_FORMAT, "rule 'fixed' needs 'at'"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"contact\": [\"g\"]}]}",
+         POSE_ERR_INVALID_DATA, "'contact' names 'g', which is not in 'bones'"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"parent_contact\": [\"x\"]}]}",
+         POSE_ERR_INVALID_DATA, "'parent_contact' names 'x', which is not in parent 'pelvis' bones"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"limits\": {\"y\": [10, -10]}}]}",
+         POSE_ERR_FORMAT, "'limits.y' must be [min, max]"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"limits\": {\"order\": \"XXY\"}}]}",
+         POSE_ERR_FORMAT, "'limits.order' must be one of"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"axis\": [0, 0, 0]}]}",
+         POSE_ERR_FORMAT, "'axis' must be a non-zero [x, y, z]"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"contact_mm\": -1}]}",
+         POSE_ERR_FORMAT, "'contact_mm' must be a number in (0, 100]"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"colour\": 1}]}",
+         POSE_ERR_FORMAT, "t.json:3: joint 'hip': unknown key 'colour'"},
+        {HEAD "{\"name\": \"0123456789012345678901234567890123456789012345678901234567890123\", "
+              "\"rule\": \"root\", \"bones\": [\"p\"]}]}",
+         POSE_ERR_FORMAT, "'name' must be a string of 1..63 bytes"},
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        pp_template t;
+        char err[512];
+        int rc = pp_template_parse(cases[i].text, strlen(cases[i].text), "t.json", &t, err, sizeof err);
+        if (rc != cases[i].status || !strstr(err, cases[i].message))
+            fail_msg("case %zu: status %d, message '%s'; expected %d and '%s'", i, rc, err,
+                     cases[i].status, cases[i].message);
+        assert_int_equal(t.joint_count, 0);
+        assert_null(t.joints);
+    }
+}
+
+static void test_missing_file(void **state)
+{
+    (void)state;
+    pp_template t;
+    char err[512];
+    assert_int_equal(pp_template_load("/nonexistent/full_body.json", &t, err, sizeof err), POSE_ERR_IO);
+    assert_non_null(strstr(err, "/nonexistent/full_body.json: cannot open"));
+}
+
+static void test_reads_minimal(void **state)
+{
+    (void)state;
+    const char *text = HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"hinge\", "
+                            "\"bones\": [\"f\", \"pat\"], \"contact\": [\"f\"], \"fit\": \"both\", "
+                            "\"contact_mm\": 7.5, \"grow_mm\": 30, \"axis\": [0, 2, 0], \"up\": [0, 0, -1], "
+                            "\"limits\": {\"order\": \"ZXY\", \"y\": [-120, 30]}}]}";
+    pp_template t;
+    char err[512];
+    assert_int_equal(pp_template_parse(text, strlen(text), "t.json", &t, err, sizeof err), POSE_OK);
+    assert_int_equal(t.joint_count, 2);
+    const pp_template_joint *j = &t.joints[1];
+    assert_string_equal(j->name, "hip");
+    assert_int_equal(j->parent, 0);
+    assert_int_equal(j->rule, PP_FIT_HINGE);
+    assert_int_equal(j->side, PP_SIDE_BOTH);
+    assert_int_equal(j->bone_count, 2);
+    assert_string_equal(j->bones[1], "pat");
+    assert_int_equal(j->contact_count, 1);
+    assert_true(j->contact_mm == 7.5f && j->grow_mm == 30.0f);
+    assert_true(j->axis[1] == 1.0f && j->up[2] == -1.0f); /* normalized */
+    assert_int_equal(j->limit_flags, POSE_LIMIT_Y);
+    assert_int_equal(j->limit_order, POSE_EULER_ZXY);
+    assert_true(j->limit_min_deg[1] == -120.0f && j->limit_max_deg[1] == 30.0f);
+    assert_int_equal(pp_template_joint_of_bone(&t, "pat"), 1);
+    assert_int_equal(pp_template_joint_of_bone(&t, "skin"), -1);
+    assert_int_equal(t.joints[0].contact_mm, 4.0f); /* the default */
+    pp_template_free(&t);
+    pp_template_free(&t); /* harmless twice */
+}
+
+/* The shipped full-body template: the names other components map onto. */
+static void test_full_body_template(void **state)
+{
+    (void)state;
+    const char *data = getenv("POSE_DATA_DIR");
+    assert_non_null(data);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/../preprocess/templates/full_body.json", data);
+    pp_template t;
+    char err[512];
+    assert_int_equal(pp_template_load(path, &t, err, sizeof err), POSE_OK);
+    static const char *names[] = {"pelvis", "lumbar", "thorax", "neck", "head",
+                                  "clavicle_r", "shoulder_r", "elbow_r", "wrist_r",
+                                  "clavicle_l", "shoulder_l", "elbow_l", "wrist_l",
+                                  "hip_r", "knee_r", "ankle_r", "hip_l", "knee_l", "ankle_l"};
+    assert_int_equal(t.joint_count, sizeof names / sizeof names[0]);
+    for (size_t i = 0; i < t.joint_count; i++)
+        assert_int_equal(pp_template_find_joint(&t, names[i]), (int)i);
+    assert_int_equal(t.joints[pp_template_find_joint(&t, "knee_r")].parent,
+                     pp_template_find_joint(&t, "hip_r"));
+    assert_int_equal(pp_template_joint_of_bone(&t, "r_tibia"), pp_template_find_joint(&t, "knee_r"));
+    assert_int_equal(pp_template_joint_of_bone(&t, "l_3distph"), pp_template_find_joint(&t, "wrist_l"));
+    /* 102 bones, each in exactly one segment. */
+    size_t bones = 0;
+    for (size_t i = 0; i < t.joint_count; i++)
+        bones += t.joints[i].bone_count;
+    assert_int_equal(bones, 102);
+    pp_template_free(&t);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_rejects_malformed),
+        cmocka_unit_test(test_missing_file),
+        cmocka_unit_test(test_reads_minimal),
+        cmocka_unit_test(test_full_body_template),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
