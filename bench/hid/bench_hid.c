@@ -120,6 +120,36 @@ int main(int argc, char **argv)
     if (pb_mannequin_recording(PB_MOTION_ARM_RAISE, 1000, 60, 11, &rec60, &err) != POSE_OK)
         die("recording", &err);
     size_t expected = rec60->event_count;
+    /* hid-recorder text of those 60 s: write it, read it back. */
+    char tmp_path[] = "/tmp/bench_hid_XXXXXX";
+    int fd = mkstemp(tmp_path);
+    FILE *tf = fd >= 0 ? fdopen(fd, "w") : NULL;
+    if (!tf)
+        die("temporary file", NULL);
+    t0 = pb_hid_now_ns();
+    int werr = pb_hid_recorder_write_device(tf, -1, &rec60->devices[0]);
+    for (size_t i = 0; !werr && i < rec60->event_count; i++)
+        werr = pb_hid_recorder_write_event(tf, rec60->events[i].t_ns, rec60->data + rec60->events[i].offset,
+                                           rec60->events[i].len);
+    if (fclose(tf) != 0 || werr)
+        die("writing the recording", NULL);
+    double write_s = (double)(pb_hid_now_ns() - t0) * 1e-9;
+    pb_hid_recording *back;
+    t0 = pb_hid_now_ns();
+    if (pb_hid_recording_load(tmp_path, &back, &err) != POSE_OK)
+        die("reading the recording", &err);
+    double read_s = (double)(pb_hid_now_ns() - t0) * 1e-9;
+    FILE *sz = fopen(tmp_path, "rb");
+    double mb = 0;
+    if (sz) {
+        fseek(sz, 0, SEEK_END);
+        mb = (double)ftell(sz) / 1e6;
+        fclose(sz);
+    }
+    remove(tmp_path);
+    if (back->event_count != expected)
+        die("read back a different number of events", NULL);
+    pb_hid_recording_free(back);
     pb_hid_replay_options fast = {.as_fast_as_possible = 1};
     pb_source *src;
     if (pb_hid_replay_create(rec60, "60 s at 1 kHz", &fast, &src, &err) != POSE_OK)
@@ -175,7 +205,8 @@ int main(int argc, char **argv)
     double p50 = rt_n ? late[rt_n / 2] : 0, p99 = rt_n ? late[rt_n * 99 / 100] : 0, mx = rt_n ? late[rt_n - 1] : 0;
 
     if (json) {
-        printf("{\"decode_ns_per_report\":%.1f,\"decode_map_ns_per_report\":%.1f,\"replay_reports\":%zu,"
+        printf("{\"recording_mb\":%.2f,\"write_mb_s\":%.1f,\"read_mb_s\":%.1f,", mb, mb / write_s, mb / read_s);
+        printf("\"decode_ns_per_report\":%.1f,\"decode_map_ns_per_report\":%.1f,\"replay_reports\":%zu,"
                "\"replay_expected\":%zu,\"replay_seconds\":%.3f,\"replay_reports_per_s\":%.0f,"
                "\"dropped\":%zu,\"reordered\":%zu,\"realtime_reports\":%zu,\"lateness_us_p50\":%.1f,"
                "\"lateness_us_p99\":%.1f,\"lateness_us_max\":%.1f}\n",
@@ -185,6 +216,8 @@ int main(int argc, char **argv)
         printf("16-axis mannequin report (28 bytes, 18 channels, 16 mapped joint DOFs):\n");
         printf("  decode only                         %8.1f ns/report\n", decode_ns);
         printf("  decode + map + joint quaternions    %8.1f ns/report   (target < 20000 ns)\n", map_ns);
+        printf("hid-recorder text, 60 s at 1 kHz (%.2f MB): write %.1f MB/s, read %.1f MB/s\n", mb, mb / write_s,
+               mb / read_s);
         printf("sustained replay, 60 s at 1 kHz, as fast as possible (source + decode + map):\n");
         printf("  %zu / %zu reports in %.3f s = %.0f reports/s (%.0fx real time), dropped %zu, reordered %zu\n", got,
                expected, replay_s, (double)got / replay_s, 60.0 / replay_s, dropped, reordered);

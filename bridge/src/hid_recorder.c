@@ -333,12 +333,24 @@ void pb_hid_recording_free(pb_hid_recording *rec)
     free(rec);
 }
 
+/* " xx" per byte and the newline, formatted in chunks (fprintf per byte is 5x slower). */
 static int write_bytes(FILE *f, const uint8_t *b, size_t n)
 {
-    for (size_t i = 0; i < n; i++)
-        if (fprintf(f, " %02x", b[i]) < 0)
-            return -1;
-    return fputc('\n', f) == EOF ? -1 : 0;
+    static const char hex[] = "0123456789abcdef";
+    char buf[3 * 256 + 1];
+    size_t k = 0;
+    for (size_t i = 0; i < n; i++) {
+        buf[k++] = ' ';
+        buf[k++] = hex[b[i] >> 4];
+        buf[k++] = hex[b[i] & 15];
+        if (k == 3 * 256) {
+            if (fwrite(buf, 1, k, f) != k)
+                return -1;
+            k = 0;
+        }
+    }
+    buf[k++] = '\n';
+    return fwrite(buf, 1, k, f) == k ? 0 : -1;
 }
 
 int pb_hid_recorder_write_device(FILE *f, int index, const pb_hid_rec_device *dev)
