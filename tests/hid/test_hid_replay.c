@@ -14,6 +14,7 @@
 
 #include <cmocka.h>
 
+#include "hid_hidraw.h"
 #include "hid_mannequin.h"
 #include "hid_open.h"
 
@@ -51,6 +52,11 @@ static void test_invalid(void **state)
     assert_null(src);
     st = pb_hid_open("/dev/hidraw999", NULL, &src, &err);
     assert_true(st == POSE_ERR_NOT_FOUND || st == POSE_ERR_UNSUPPORTED);
+    uint8_t desc[64];
+    size_t len = 1;
+    assert_int_equal(pb_hid_hidraw_descriptor("/dev/hidraw999", desc, sizeof desc, &len, &err), POSE_ERR_IO);
+    assert_int_equal(len, 0);
+    assert_non_null(strstr(err.message, "/dev/hidraw999"));
     char path[1024];
     data_path(path, sizeof path, "mannequin_arm_raise.hid");
     pb_hid_replay_options opt = {.device = 3};
