@@ -226,11 +226,16 @@ static POSE__INLINE void store_normals(const pose__transfer_mesh *m, const pose_
 
 #define TRANSFER_BATCH 16 /* blocks whose raw normals wait in L1 */
 
-void POSE__KV(pose__transfer_blocks)(const pose__transfer_mesh *m, const float *restrict tp,
-                                     size_t begin, size_t end, float *restrict pos,
-                                     float *restrict nrm)
+/* A deformed tet whose corner volume is below this share of |e1||e2||e3|
+ * (or negative) is too flat or inverted for its affine map to carry normals. */
+#define FLAT_TET 0.05f
+
+size_t POSE__KV(pose__transfer_blocks)(const pose__transfer_mesh *m, const float *restrict tp,
+                                       size_t begin, size_t end, float *restrict pos,
+                                       float *restrict nrm, uint32_t *restrict flagged)
 {
     pose__v8f raw[TRANSFER_BATCH][3];
+    size_t nflagged = 0;
     size_t batch_start = begin;
     for (size_t b = begin; b < end; b++) {
         const uint32_t *tv = m->tet_vertices + 4 * POSE__BLOCK * b;
@@ -257,12 +262,26 @@ void POSE__KV(pose__transfer_blocks)(const pose__transfer_mesh *m, const float *
         const pose__v8f k3 = __builtin_convertvector(*(const pose__v8i16 *)(kb + 16), pose__v8f);
         /* cof(D') k = k1 (e2 x e3) + k2 (e3 x e1) + k3 (e1 x e2) */
         pose__v8f *r = raw[b - batch_start];
-        r[0] = k1 * (e2y * e3z - e2z * e3y) + k2 * (e3y * e1z - e3z * e1y) +
-               k3 * (e1y * e2z - e1z * e2y);
-        r[1] = k1 * (e2z * e3x - e2x * e3z) + k2 * (e3z * e1x - e3x * e1z) +
-               k3 * (e1z * e2x - e1x * e2z);
-        r[2] = k1 * (e2x * e3y - e2y * e3x) + k2 * (e3x * e1y - e3y * e1x) +
-               k3 * (e1x * e2y - e1y * e2x);
+        const pose__v8f c23x = e2y * e3z - e2z * e3y, c23y = e2z * e3x - e2x * e3z,
+                        c23z = e2x * e3y - e2y * e3x;
+        r[0] = k1 * c23x + k2 * (e3y * e1z - e3z * e1y) + k3 * (e1y * e2z - e1z * e2y);
+        r[1] = k1 * c23y + k2 * (e3z * e1x - e3x * e1z) + k3 * (e1z * e2x - e1x * e2z);
+        r[2] = k1 * c23z + k2 * (e3x * e1y - e3y * e1x) + k3 * (e1x * e2y - e1y * e2x);
+        /* det D' = e1 . (e2 x e3), compared with |e1| |e2| |e3| squared */
+        const pose__v8f det = e1x * c23x + e1y * c23y + e1z * c23z;
+        const pose__v8f l1 = e1x * e1x + e1y * e1y + e1z * e1z;
+        const pose__v8f l2 = e2x * e2x + e2y * e2y + e2z * e2z;
+        const pose__v8f l3 = e3x * e3x + e3y * e3y + e3z * e3z;
+        const pose__v8i bad = (det <= 0.0f) | (det * det <= (FLAT_TET * FLAT_TET) * (l1 * l2 * l3));
+        int any = 0;
+        for (int l = 0; l < 8; l++)
+            any |= bad[l];
+        if (any) {
+            size_t count = m->vertex_count - b * POSE__BLOCK;
+            for (size_t l = 0; l < 8 && l < count; l++)
+                if (bad[l])
+                    flagged[nflagged++] = (uint32_t)(b * POSE__BLOCK + l);
+        }
         if (b + 1 - batch_start == TRANSFER_BATCH || b + 1 == end) {
             store_normals(m, (const pose__v8f(*)[3])raw, batch_start, b + 1 - batch_start, nrm);
             batch_start = b + 1;
@@ -271,4 +290,5 @@ void POSE__KV(pose__transfer_blocks)(const pose__transfer_mesh *m, const float *
 #ifdef __AVX2__
     _mm_sfence(); /* order the streaming stores before the pool's hand-back */
 #endif
+    return nflagged;
 }

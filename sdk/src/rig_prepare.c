@@ -71,8 +71,10 @@ static void rest_normals(const pose__tissue *t, float *out)
     }
 }
 
-/* One tissue vertex: tet vertices with the largest coordinate first,
- * b1..b3, and the normal key sign(det D) D^T n (see rt_transfer.h). */
+/* One tissue vertex: tet vertices with the largest coordinate first, the
+ * other three ordered so that det D > 0 (D = [v1-v0 v2-v0 v3-v0] at rest:
+ * an inverted tet then shows as det D' <= 0), b1..b3, and the normal key
+ * D^T n (see rt_transfer.h). */
 static void embed_vertex(const pose_rig *rig, const uint32_t *tet, const float *b4,
                          const float *normal, uint32_t *tv, float *b3, int16_t *key)
 {
@@ -84,27 +86,66 @@ static void embed_vertex(const pose_rig *rig, const uint32_t *tet, const float *
     for (unsigned k = 0, n = 1; k < 4; k++)
         if (k != first)
             perm[n++] = k;
-    for (unsigned k = 0; k < 4; k++)
-        tv[k] = tet[perm[k]];
-    for (unsigned k = 0; k < 3; k++)
-        b3[k] = b4[perm[k + 1]];
 
-    const float *v0 = rig->tet_positions + 3 * (size_t)tv[0];
-    double e[3][3], m[3];
+    double e[3][3];
+    const float *v0 = rig->tet_positions + 3 * (size_t)tet[perm[0]];
     for (int k = 0; k < 3; k++) {
-        const float *vk = rig->tet_positions + 3 * (size_t)tv[k + 1];
+        const float *vk = rig->tet_positions + 3 * (size_t)tet[perm[k + 1]];
         for (int d = 0; d < 3; d++)
             e[k][d] = (double)vk[d] - v0[d];
-        m[k] = e[k][0] * normal[0] + e[k][1] * normal[1] + e[k][2] * normal[2];
     }
     double det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
                  e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
                  e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+    if (det < 0.0) { /* swapping two edges flips the sign */
+        unsigned t = perm[2]; perm[2] = perm[3]; perm[3] = t;
+        for (int d = 0; d < 3; d++) {
+            double x = e[1][d]; e[1][d] = e[2][d]; e[2][d] = x;
+        }
+    }
+    for (unsigned k = 0; k < 4; k++)
+        tv[k] = tet[perm[k]];
+    double m[3];
+    for (unsigned k = 0; k < 3; k++) {
+        b3[k] = b4[perm[k + 1]];
+        m[k] = e[k][0] * normal[0] + e[k][1] * normal[1] + e[k][2] * normal[2];
+    }
     double big = fmax(fabs(m[0]), fmax(fabs(m[1]), fabs(m[2])));
     for (int k = 0; k < 3; k++)
-        key[k] = (big > 0.0 && det != 0.0)
-                     ? (int16_t)lround((det < 0.0 ? -m[k] : m[k]) / big * 32767.0)
-                     : 0;
+        key[k] = (big > 0.0 && det != 0.0) ? (int16_t)lround(m[k] / big * 32767.0) : 0;
+}
+
+/* For every tissue vertex v (all tissues, one numbering), the other two
+ * corners (a, b) of each triangle around it, in winding order: the
+ * area-weighted normal is sum (a - v) x (b - v). */
+static void build_fans(const pose_rig *rig, const size_t *tissue_offset, uint32_t *fan_offset,
+                       uint32_t *fan)
+{
+    for (size_t t = 0; t < rig->tissue_count; t++) {
+        const pose__tissue *ts = &rig->tissues[t];
+        for (size_t f = 0; f < 3 * ts->triangle_count; f++)
+            fan_offset[tissue_offset[t] + ts->triangles[f] + 1]++;
+    }
+    size_t total = tissue_offset[rig->tissue_count];
+    for (size_t v = 0; v < total; v++)
+        fan_offset[v + 1] += fan_offset[v];
+    /* fill, using fan_offset[v] as a cursor, then shift back */
+    for (size_t t = 0; t < rig->tissue_count; t++) {
+        const pose__tissue *ts = &rig->tissues[t];
+        const uint32_t base = (uint32_t)tissue_offset[t];
+        for (size_t f = 0; f < ts->triangle_count; f++) {
+            const uint32_t *tri = ts->triangles + 3 * f;
+            for (int k = 0; k < 3; k++) {
+                uint32_t v = base + tri[k];
+                uint32_t at = fan_offset[v]++;
+                fan[2 * (size_t)at] = base + tri[(k + 1) % 3];
+                fan[2 * (size_t)at + 1] = base + tri[(k + 2) % 3];
+            }
+        }
+    }
+    for (size_t v = total; v > 0; v--)
+        fan_offset[v] = fan_offset[v - 1];
+    fan_offset[0] = 0;
 }
 
 pose_status pose__rig_prepare(pose_rig *rig)
@@ -144,6 +185,17 @@ pose_status pose__rig_prepare(pose_rig *rig)
     off += align64(tb * 3 * B * sizeof(int16_t));
     const size_t off_normals = off;
     off += align64(total * 3 * sizeof(float));
+    size_t fan_entries = 0;
+    for (size_t t = 0; t < rig->tissue_count; t++)
+        fan_entries += 3 * rig->tissues[t].triangle_count;
+    if (total >= UINT32_MAX || fan_entries >= UINT32_MAX)
+        return pose__fail(POSE_ERR_UNSUPPORTED,
+                          "tissues with %zu vertices and %zu triangle corners: the runtime "
+                          "handles fewer than 2^32", total, fan_entries);
+    const size_t off_fan_offset = off;
+    off += align64((total + 1) * sizeof(uint32_t));
+    const size_t off_fan = off;
+    off += align64(2 * fan_entries * sizeof(uint32_t));
     const size_t off_frames = off;
     off += align64(nj * sizeof(pose__xform));
     const size_t size = off;
@@ -216,9 +268,12 @@ pose_status pose__rig_prepare(pose_rig *rig)
         base += ts->vertex_count;
     }
     rt->tissue_offset[rig->tissue_count] = base;
+    uint32_t *fan_offset = (uint32_t *)(block + off_fan_offset);
+    uint32_t *fan = (uint32_t *)(block + off_fan);
+    build_fans(rig, rt->tissue_offset, fan_offset, fan);
     rt->transfer = (pose__transfer_mesh){
         .vertex_count = total, .block_count = tb, .tet_vertices = tv, .bary = bary,
-        .normal_key = key,
+        .normal_key = key, .fan_offset = fan_offset, .fan = fan,
     };
 
     rt->rest_model = (pose__xform *)(block + off_frames);

@@ -9,9 +9,6 @@
 #include "rt_transfer.h"
 #include "state_internal.h"
 
-/* More threads than this cannot help a memory-bound kernel. */
-#define POSE__MAX_THREADS 256
-
 static size_t align64(size_t n)
 {
     return (n + 63u) & ~(size_t)63u;
@@ -43,6 +40,11 @@ static pose_status start_pool(pose_state *st, unsigned threads)
     }
     st->pool = pool;
     return POSE_OK;
+}
+
+static size_t st_blocks(const pose_rig *rig)
+{
+    return rig->rt->transfer.block_count;
 }
 
 static pose_status check_method(const pose_rig *rig, pose_method method)
@@ -108,7 +110,10 @@ pose_status pose_state_create_ex(const pose_rig *rig, const pose_state_options *
     size_t off_tet = off_palette + align64(nj * sizeof(pose__skin_joint));
     size_t off_pos = off_tet + align64(3 * nv * sizeof(float) + 16); /* slack: rt_transfer.h */
     size_t off_nrm = off_pos + align64(3 * nt * sizeof(float));
-    size_t size = off_nrm + align64(3 * nt * sizeof(float));
+    size_t off_flagged = off_nrm + align64(3 * nt * sizeof(float));
+    const size_t nt_padded = st_blocks(rig) * POSE__BLOCK;
+    size_t off_counts = off_flagged + align64(nt_padded * sizeof(uint32_t));
+    size_t size = off_counts + align64(POSE__MAX_THREADS * sizeof(size_t));
 
     pose_allocator alloc = pose__allocator_resolve(&opt.allocator);
     unsigned char *block = pose__alloc(&alloc, size, POSE__ALIGN);
@@ -129,6 +134,8 @@ pose_status pose_state_create_ex(const pose_rig *rig, const pose_state_options *
     st->tet_positions = (float *)(block + off_tet);
     st->tissue_positions = (float *)(block + off_pos);
     st->tissue_normals = (float *)(block + off_nrm);
+    st->flagged = (uint32_t *)(block + off_flagged);
+    st->flagged_count = (size_t *)(block + off_counts);
     for (size_t j = 0; j < nj; j++)
         pose__quat_identity(st->local[j]);
     pose__xform_identity(&st->root);
@@ -207,7 +214,19 @@ static void transfer_task(void *ctx, unsigned part, unsigned parts)
     const pose__transfer_mesh *mesh = &st->rt->transfer;
     size_t b = pose__part_begin(mesh->block_count, part, parts);
     size_t e = pose__part_begin(mesh->block_count, part + 1, parts);
-    pose__transfer(mesh, st->tet_positions, b, e, st->tissue_positions, st->tissue_normals);
+    st->flagged_count[part] = pose__transfer(mesh, st->tet_positions, b, e, st->tissue_positions,
+                                             st->tissue_normals, st->flagged + b * POSE__BLOCK);
+}
+
+/* Normals of the vertices in flat or inverted tets, from their triangles:
+ * needs every position, hence a pass of its own. */
+static void fix_normals_task(void *ctx, unsigned part, unsigned parts)
+{
+    pose_state *st = ctx;
+    const pose__transfer_mesh *mesh = &st->rt->transfer;
+    size_t b = pose__part_begin(mesh->block_count, part, parts);
+    pose__transfer_fix_normals(mesh, st->tissue_positions, st->flagged + b * POSE__BLOCK,
+                               st->flagged_count[part], st->tissue_normals);
 }
 
 pose_status pose_apply(pose_state *st)
@@ -221,6 +240,11 @@ pose_status pose_apply(pose_state *st)
     pose__skin_palette(rig->joint_count, st->skin, st->palette);
     pose__pool_run(st->pool, skin_task, st);
     pose__pool_run(st->pool, transfer_task, st);
+    size_t flagged = 0;
+    for (unsigned p = 0; p < pose__pool_threads(st->pool); p++)
+        flagged += st->flagged_count[p];
+    if (flagged > 0)
+        pose__pool_run(st->pool, fix_normals_task, st);
     return POSE_OK;
 }
 

@@ -6,6 +6,7 @@
 #define POSE_STATE_INTERNAL_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "pose/pose.h"
 #include "rig_internal.h"
@@ -29,10 +30,16 @@ struct pose_state {
     float *tet_positions;       /**< 3 * tet vertices */
     float *tissue_positions;    /**< 3 * all tissue vertices (rt->tissue_offset) */
     float *tissue_normals;      /**< same layout */
+    uint32_t *flagged;          /**< tissue vertices whose normals come from triangles
+                                     this frame; part p lists from its first vertex */
+    size_t *flagged_count;      /**< per part (POSE__MAX_THREADS) */
 
     pose__pool *pool;           /**< own allocation: replaced by pose_set_threads */
     void *block;                /**< the allocation holding everything else */
 };
+
+/** Most worker threads a state runs. */
+#define POSE__MAX_THREADS 256
 
 /** Bytes pose_apply must move per frame with the state's method: every
  *  array the kernels stream, read or written once (benchmarks). */

@@ -235,7 +235,8 @@ static void test_transfer_affine_exact(void **unused)
     }
     packed_transfer pt = pack_transfer(N, tv, bary, key);
     float *pos = zalloc(3 * N * sizeof(float)), *nrm = zalloc(3 * N * sizeof(float));
-    pose__transfer(&pt.mesh, moved, 0, pt.mesh.block_count, pos, nrm);
+    uint32_t flagged[N];
+    assert_int_equal(pose__transfer(&pt.mesh, moved, 0, pt.mesh.block_count, pos, nrm, flagged), 0);
     for (int i = 0; i < N; i++) {
         double nn[3], l = 0;
         for (int r = 0; r < 3; r++) {
@@ -251,7 +252,7 @@ static void test_transfer_affine_exact(void **unused)
     }
     /* positions only (normals skipped) give the same positions */
     float *pos2 = zalloc(3 * N * sizeof(float));
-    pose__transfer(&pt.mesh, moved, 0, pt.mesh.block_count, pos2, NULL);
+    pose__transfer(&pt.mesh, moved, 0, pt.mesh.block_count, pos2, NULL, NULL);
     assert_memory_equal(pos, pos2, 3 * N * sizeof(float));
     free(pos);
     free(pos2);
@@ -310,6 +311,7 @@ static void test_variants_identical(void **unused)
     }
     packed_transfer pt = pack_transfer(NT, tv, bary, key);
     float *out[2][3], *aligned[2][3];
+    size_t flagged_count[2][3];
     for (int v = 0; v < 2; v++) {
         pose__kernels_force_generic(v);
         for (int method = 0; method < 3; method++) {
@@ -318,12 +320,17 @@ static void test_variants_identical(void **unused)
             pose__skin(method, &ps.mesh, pal, 0, ps.mesh.block_count, o);
             memcpy(tp, o, 3 * NV * sizeof(float));
             /* odd offsets: outputs not 32-byte aligned take the lane path */
-            pose__transfer(&pt.mesh, tp, 0, pt.mesh.block_count, o + 3 * NV + 1,
-                           o + 3 * NV + 3 * NT + 1);
+            uint32_t fl[2][NT + 8];
+            size_t nf = pose__transfer(&pt.mesh, tp, 0, pt.mesh.block_count, o + 3 * NV + 1,
+                                       o + 3 * NV + 3 * NT + 1, fl[0]);
             /* and aligned ones take the vector (streaming) path */
             aligned[v][method] = zalloc(2 * 3 * NT * sizeof(float) + 64);
             float *a = aligned[v][method];
-            pose__transfer(&pt.mesh, tp, 0, pt.mesh.block_count, a, a + ((3 * NT + 15) & ~15));
+            size_t nf2 = pose__transfer(&pt.mesh, tp, 0, pt.mesh.block_count, a,
+                                        a + ((3 * NT + 15) & ~15), fl[1]);
+            assert_int_equal(nf, nf2);
+            assert_memory_equal(fl[0], fl[1], nf * sizeof(uint32_t));
+            flagged_count[v][method] = nf;
         }
     }
     pose__kernels_force_generic(0);
@@ -331,6 +338,7 @@ static void test_variants_identical(void **unused)
         assert_memory_equal(out[0][method], out[1][method],
                             3 * NV * sizeof(float) + 3 * 2 * NT * sizeof(float) + 4);
         assert_memory_equal(aligned[0][method], aligned[1][method], 2 * 3 * NT * sizeof(float));
+        assert_int_equal(flagged_count[0][method], flagged_count[1][method]);
         /* the unaligned and aligned paths agree too */
         assert_memory_equal(aligned[1][method], out[1][method] + 3 * NV + 1, 3 * NT * sizeof(float));
         free(out[0][method]);
@@ -339,6 +347,38 @@ static void test_variants_identical(void **unused)
         free(aligned[1][method]);
     }
     free_skin(&ps);
+    free_transfer(&pt);
+}
+
+/* A vertex whose tet is turned inside out is listed, and gets the normal of
+ * its triangle fan. */
+static void test_inverted_tet_uses_triangle_normal(void **unused)
+{
+    (void)unused;
+    /* tissue vertex 0 at the centre of a fan of 4 triangles in the plane z = 0 */
+    const uint32_t tv[4] = {0, 1, 2, 3};
+    const float b3[3] = {0.1f, 0.1f, 0.1f};
+    const int16_t key[3] = {0, 0, 32767};
+    packed_transfer pt = pack_transfer(1, tv, b3, key);
+    const uint32_t fan_offset[2] = {0, 4};
+    const uint32_t fan[8] = {1, 2, 2, 3, 3, 4, 4, 1}; /* neighbours 1..4 counter-clockwise */
+    pt.mesh.fan_offset = fan_offset;
+    pt.mesh.fan = fan;
+    float good[16] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    float inverted[16] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, -1}; /* v3 pushed through */
+    float *pos = zalloc(3 * sizeof(float)), *nrm = zalloc(3 * sizeof(float));
+    uint32_t flagged[8];
+    assert_int_equal(pose__transfer(&pt.mesh, good, 0, 1, pos, nrm, flagged), 0);
+    assert_int_equal(pose__transfer(&pt.mesh, inverted, 0, 1, pos, nrm, flagged), 1);
+    assert_int_equal(flagged[0], 0);
+    /* positions of the fan: the vertex and a square around it, tilted about x */
+    float surface[15] = {0, 0, 0, 1, 0, 0, 0, 0.8f, 0.6f, -1, 0, 0, 0, -0.8f, -0.6f};
+    pose__transfer_fix_normals(&pt.mesh, surface, flagged, 1, nrm);
+    assert_near(nrm[0], 0.0, 1e-6);
+    assert_near(nrm[1], -0.6, 1e-6);
+    assert_near(nrm[2], 0.8, 1e-6);
+    free(pos);
+    free(nrm);
     free_transfer(&pt);
 }
 
@@ -383,6 +423,7 @@ int main(void)
         cmocka_unit_test(test_transfer_affine_exact),
         cmocka_unit_test(test_euler_round_trip),
         cmocka_unit_test(test_variants_identical),
+        cmocka_unit_test(test_inverted_tet_uses_triangle_normal),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
