@@ -226,10 +226,6 @@ static POSE__INLINE void store_normals(const pose__transfer_mesh *m, const pose_
 
 #define TRANSFER_BATCH 16 /* blocks whose raw normals wait in L1 */
 
-/* A deformed tet whose corner volume is below this share of |e1||e2||e3|
- * (or negative) is too flat or inverted for its affine map to carry normals. */
-#define FLAT_TET 0.05f
-
 size_t POSE__KV(pose__transfer_blocks)(const pose__transfer_mesh *m, const float *restrict tp,
                                        size_t begin, size_t end, float *restrict pos,
                                        float *restrict nrm, uint32_t *restrict flagged)
@@ -267,12 +263,9 @@ size_t POSE__KV(pose__transfer_blocks)(const pose__transfer_mesh *m, const float
         r[0] = k1 * c23x + k2 * (e3y * e1z - e3z * e1y) + k3 * (e1y * e2z - e1z * e2y);
         r[1] = k1 * c23y + k2 * (e3z * e1x - e3x * e1z) + k3 * (e1z * e2x - e1x * e2z);
         r[2] = k1 * c23z + k2 * (e3x * e1y - e3y * e1x) + k3 * (e1x * e2y - e1y * e2x);
-        /* det D' = e1 . (e2 x e3), compared with |e1| |e2| |e3| squared */
+        /* det D' = e1 . (e2 x e3) <= 0: the tet is flat or inside out (det D > 0 at rest) */
         const pose__v8f det = e1x * c23x + e1y * c23y + e1z * c23z;
-        const pose__v8f l1 = e1x * e1x + e1y * e1y + e1z * e1z;
-        const pose__v8f l2 = e2x * e2x + e2y * e2y + e2z * e2z;
-        const pose__v8f l3 = e3x * e3x + e3y * e3y + e3z * e3z;
-        const pose__v8i bad = (det <= 0.0f) | (det * det <= (FLAT_TET * FLAT_TET) * (l1 * l2 * l3));
+        const pose__v8i bad = det <= 0.0f;
         int any = 0;
         for (int l = 0; l < 8; l++)
             any |= bad[l];

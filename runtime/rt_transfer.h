@@ -39,8 +39,8 @@ typedef struct pose__transfer_mesh {
  * interleaved at pos/nrm + 3 * vertex; padding lanes are not written.
  * tet_positions must stay readable for 16 bytes past its last vertex
  * (vertices are loaded 16 bytes at a time). With normals, the vertices whose
- * tet is (nearly) flat or inverted are written to `flagged` (room for 8 per
- * block) and their count returned; their normals are left for
+ * tet is flat or inverted (det D' <= 0) are written to `flagged` (room for 8
+ * per block) and their count returned; their normals are left for
  * pose__transfer_fix_normals once every position is known.
  */
 size_t pose__transfer(const pose__transfer_mesh *mesh, const float *tet_positions, size_t begin,
