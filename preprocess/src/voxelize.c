@@ -36,8 +36,9 @@ uint16_t pp_voxels_sample(const pp_voxels *v, const float p[3])
 
 /* Label one bone inside its own bounding sub-grid. */
 static pose_status label_bone(const pp_mesh *bone, uint16_t label, pp_voxels *v,
-                              const uint8_t *in_skin, pp_voxel_report *r)
+                              const uint8_t *in_skin, pp_voxel_report *r, size_t *inside_skin)
 {
+    *inside_skin = 0;
     float lo[3], hi[3];
     pp_mesh_bounds(bone, lo, hi);
     int i0[3], i1[3], n[3];
@@ -70,6 +71,7 @@ static pose_status label_bone(const pp_mesh *bone, uint16_t label, pp_voxels *v,
                     continue;
                 size_t g = (size_t)(x + i0[0]) +
                            (size_t)v->nx * ((size_t)(y + i0[1]) + (size_t)v->ny * (z + i0[2]));
+                *inside_skin += in_skin[g];
                 uint16_t old = v->labels[g];
                 if (old >= PP_VOXEL_BONE0) {
                     if (old != label)
@@ -93,6 +95,7 @@ static pose_status label_bone(const pp_mesh *bone, uint16_t label, pp_voxels *v,
             int c[3];
             voxel_of(v, bone->positions + 3 * i, c);
             size_t g = (size_t)c[0] + (size_t)v->nx * ((size_t)c[1] + (size_t)v->ny * c[2]);
+            *inside_skin += in_skin[g];
             if (v->labels[g] >= PP_VOXEL_BONE0) {
                 marked += v->labels[g] == label;
                 continue;
@@ -217,10 +220,20 @@ pose_status pp_voxelize(const pp_mesh *skin, const pp_mesh *bones, const uint16_
         if (pp_mesh_topology_count(&bones[b], &topo) == POSE_OK &&
             (topo.boundary_edges || topo.nonmanifold_edges))
             r->open_bone_meshes++;
-        s = label_bone(&bones[b], (uint16_t)(PP_VOXEL_BONE0 + bone_label[b]), out, in_skin, r);
+        size_t inside = 0;
+        s = label_bone(&bones[b], (uint16_t)(PP_VOXEL_BONE0 + bone_label[b]), out, in_skin, r,
+                       &inside);
         if (s != POSE_OK) {
             free(in_skin);
             return fail(out, err, errlen, s, "voxelize: out of memory");
+        }
+        if (inside == 0) {
+            /* Not a bone poking out: a bone in another frame or unit. */
+            free(in_skin);
+            snprintf(msg, sizeof msg,
+                     "%s: the bone lies entirely outside the skin (check its units and frame)",
+                     bones[b].name[0] ? bones[b].name : "bone");
+            return fail(out, err, errlen, POSE_ERR_INVALID_DATA, msg);
         }
         if (bone_label[b] + 1 > max_label)
             max_label = (uint16_t)(bone_label[b] + 1);

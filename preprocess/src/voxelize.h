@@ -68,7 +68,8 @@ typedef struct pp_voxel_report {
  * @param report      optional (NULL): counts and repairs
  * @return POSE_OK, POSE_ERR_INVALID_ARGUMENT (bad spacing, empty mesh,
  *         non-finite coordinate, grid too large; message names the mesh),
- *         POSE_ERR_OUT_OF_MEMORY.
+ *         POSE_ERR_INVALID_DATA (a bone with no voxel inside the skin: wrong
+ *         units or frame; message names the bone), POSE_ERR_OUT_OF_MEMORY.
  */
 pose_status pp_voxelize(const pp_mesh *skin, const pp_mesh *bones, const uint16_t *bone_label,
                         size_t bone_count, float spacing, pp_voxels *out,

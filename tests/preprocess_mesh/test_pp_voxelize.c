@@ -63,6 +63,17 @@ static void test_bad_inputs(void **state)
     pp_mesh_free(&bone);
     assert_int_equal(pp_voxelize(&box, NULL, &lab, 1, 0.01f, &v, NULL, err, sizeof err),
                      POSE_ERR_INVALID_ARGUMENT);
+
+    /* a bone in millimetres next to a skin in metres: wholly outside */
+    float blo[3] = {50, 50, 50}, bhi[3] = {60, 60, 60};
+    shape_box(&bone, blo, bhi);
+    snprintf(bone.name, sizeof bone.name, "r_femur_mm");
+    assert_int_equal(pp_voxelize(&box, &bone, &lab, 1, 0.5f, &v, NULL, err, sizeof err),
+                     POSE_ERR_INVALID_DATA);
+    assert_non_null(strstr(err, "r_femur_mm"));
+    assert_non_null(strstr(err, "outside the skin"));
+    assert_null(v.labels);
+    pp_mesh_free(&bone);
     pp_mesh_free(&box);
 }
 
