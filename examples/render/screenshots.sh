@@ -7,9 +7,12 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 body=${1:-$root/out/demo/body.rig}
 build=${2:-$root/build}
-render=$(find "$build" -maxdepth 3 -type f -name pose-render -perm -u+x | head -n 1)
-synth=$(find "$build" -maxdepth 3 -type f -name pose-synth -perm -u+x | head -n 1)
-[ -n "$render" ] && [ -n "$synth" ] || { echo "screenshots: build pose-render and pose-synth first" >&2; exit 1; }
+render=$(find "$build" -maxdepth 3 -type f -name pose-render -perm -u+x -print -quit)
+synth=$(find "$build" -maxdepth 3 -type f -name pose-synth -perm -u+x -print -quit)
+if [ -z "$render" ] || [ -z "$synth" ]; then
+    echo "screenshots: build pose-render and pose-synth first" >&2
+    exit 1
+fi
 [ -f "$body" ] || { echo "screenshots: $body not found (run bash scripts/demo.sh first)" >&2; exit 1; }
 img="$root/docs/images"
 mkdir -p "$img"

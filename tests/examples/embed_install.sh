@@ -26,7 +26,8 @@ grep -q "$tmp/prefix/.*libpose.so" "$tmp/ldd.log"
 
 # 2. Makefile: pkg-config from the prefix. --define-prefix makes pose.pc
 # answer for where it lies, since it was installed with --prefix after configure.
-export PKG_CONFIG_PATH="$tmp/prefix/lib/pkgconfig:$tmp/prefix/lib/$(gcc -print-multiarch 2>/dev/null || true)/pkgconfig"
+multiarch=$(gcc -print-multiarch 2>/dev/null || true)
+export PKG_CONFIG_PATH="$tmp/prefix/lib/pkgconfig:$tmp/prefix/lib/$multiarch/pkgconfig"
 make -s -C "$src/examples/embed" OUT="$tmp/embed-make" PKG_CONFIG="pkg-config --define-prefix" \
     CFLAGS="-O2 -Wall -Wextra -Werror"
 "$tmp/embed-make/embed" "$tmp/bar.rig" "$tmp/out/make" 60 10 | tee "$tmp/run-make.log"
@@ -35,9 +36,13 @@ grep -q "wrote 6 OBJ files" "$tmp/run-make.log"
 # The OBJ files of both builds hold the same posed skin at frame 20.
 cmp "$tmp/out/cmake/skin_0020.obj" "$tmp/out/make/skin_0020.obj"
 # ... and frame 20 is not the rest pose (frame 0).
-! cmp -s "$tmp/out/cmake/skin_0000.obj" "$tmp/out/cmake/skin_0020.obj"
+if cmp -s "$tmp/out/cmake/skin_0000.obj" "$tmp/out/cmake/skin_0020.obj"; then
+    echo "embed_install: frame 20 equals frame 0: the joint did not move the skin" >&2
+    exit 1
+fi
 
 # 3. The README quickstart, compiled as its comment says.
+# shellcheck disable=SC2046 # the flags are meant to split into words
 cc -std=c11 -Wall -Wextra -Werror -o "$tmp/quickstart" "$src/examples/quickstart/quickstart.c" \
     $(pkg-config --define-prefix --cflags --libs pose) -lm \
     -Wl,-rpath,"$(pkg-config --define-prefix --variable=libdir pose)"
