@@ -9,6 +9,10 @@
 #include "rt_transfer.h"
 #include "state_internal.h"
 
+/* Below this many blocks of 8 vertices (skin + transfer), pose_apply does
+ * not use the workers: ~16 k vertices take about as long as a wake-up. */
+#define POSE__SERIAL_BLOCKS 2048
+
 static size_t align64(size_t n)
 {
     return (n + 63u) & ~(size_t)63u;
@@ -238,6 +242,16 @@ pose_status pose_apply(pose_state *st)
     pose__fk(rig->joint_count, rig->joint_parents, st->rt->rest_model,
              (const float(*)[4])st->local, &st->root, st->skin, st->world);
     pose__skin_palette(rig->joint_count, st->skin, st->palette);
+    /* Small meshes run on the caller alone: waking workers would cost more
+     * than the work (results are the same either way). */
+    const size_t blocks = st->rt->skin.block_count + st->rt->transfer.block_count;
+    if (blocks < POSE__SERIAL_BLOCKS) {
+        skin_task(st, 0, 1);
+        transfer_task(st, 0, 1);
+        if (st->flagged_count[0] > 0)
+            fix_normals_task(st, 0, 1);
+        return POSE_OK;
+    }
     pose__pool_run(st->pool, skin_task, st);
     pose__pool_run(st->pool, transfer_task, st);
     size_t flagged = 0;

@@ -387,14 +387,16 @@ static void test_transfer_on_tet_vertices(void **unused)
     pose_rig_free(rig);
 }
 
-/* Equal results for 1, 2 and 3 threads (bit for bit), every method. */
+/* Equal results for 1, 2 and 3 threads (bit for bit), every method. The rig
+ * is big enough (> 2048 blocks of 8 vertices) for pose_apply to use its
+ * workers rather than running small meshes on the caller. */
 static void test_threads_identical(void **unused)
 {
     (void)unused;
     fx_options o = fx_defaults();
-    o.cubes = 40;
+    o.cubes = 200;
     o.joints = 5;
-    o.inner_points = 5000;
+    o.inner_points = 20000;
     pose_rig *rig = fx_bar(&o);
     size_t nt, ns, ni;
     float *ref[3] = {NULL, NULL, NULL};
