@@ -367,7 +367,12 @@ POSE_API pose_status pose_apply(pose_state *state);
  * @since 0.1
  */
 POSE_API const float *pose_tissue_positions(const pose_state *state, int tissue, size_t *vertex_count);
-/** Unit vertex normals of tissue `tissue`, as pose_tissue_positions. @since 0.1 */
+/**
+ * Unit vertex normals of tissue `tissue`, as pose_tissue_positions: the
+ * area-weighted rest normals carried by the deformation of each vertex's tet
+ * (recomputed from the deformed triangles where a tet is turned inside out);
+ * (0, 0, 0) for a vertex no triangle uses. @since 0.1
+ */
 POSE_API const float *pose_tissue_normals(const pose_state *state, int tissue, size_t *vertex_count);
 /** Deformed tet mesh vertices, as pose_tissue_positions. @since 0.1 */
 POSE_API const float *pose_tet_positions(const pose_state *state, size_t *vertex_count);
