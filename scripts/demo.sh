@@ -199,7 +199,8 @@ if [ $bake_failed -eq 1 ]; then
 else
     echo "demo: done in $((now - t0)) s. Images and files are in: $out"
 fi
-find "$out" -type f | sort | sed "s|^$out/|  |"
+find "$out" -maxdepth 1 -type f | sort | sed "s|^$out/|  |"
+echo "  frames/: $(find "$frames_dir" -name '*.png' | wc -l) PNG images"
 
 if [ $view -eq 1 ]; then
     if [ -z "${DISPLAY:-}${WAYLAND_DISPLAY:-}" ]; then
