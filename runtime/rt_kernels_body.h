@@ -210,7 +210,7 @@ void POSE__KV(pose__skin_blocks)(int method, const pose__skin_mesh *m,
  * apart from the gathers: a short, independent loop the core can overlap,
  * instead of a sqrt + divide at the end of a long dependency chain. */
 static POSE__INLINE void store_normals(const pose__transfer_mesh *m, const pose__v8f (*raw)[3],
-                                       size_t b0, size_t n, float *restrict nrm)
+                                       size_t b0, size_t n, float *restrict nrm, int stream)
 {
     for (size_t i = 0; i < n; i++) {
         pose__v8f nx = raw[i][0], ny = raw[i][1], nz = raw[i][2];
@@ -220,11 +220,12 @@ static POSE__INLINE void store_normals(const pose__transfer_mesh *m, const pose_
         nx *= s;
         ny *= s;
         nz *= s;
-        store_lanes(nrm, b0 + i, m->vertex_count, &nx, &ny, &nz, 1);
+        store_lanes(nrm, b0 + i, m->vertex_count, &nx, &ny, &nz, stream);
     }
 }
 
 #define TRANSFER_BATCH 16 /* blocks whose raw normals wait in L1 */
+#define STREAM_BYTES (16u << 20) /* tissue outputs bigger than this are streamed */
 
 size_t POSE__KV(pose__transfer_blocks)(const pose__transfer_mesh *m, const float *restrict tp,
                                        size_t begin, size_t end, float *restrict pos,
@@ -232,6 +233,9 @@ size_t POSE__KV(pose__transfer_blocks)(const pose__transfer_mesh *m, const float
 {
     pose__v8f raw[TRANSFER_BATCH][3];
     size_t nflagged = 0;
+    /* Outputs larger than a last-level cache bypass it; small ones stay hot
+     * for the caller. */
+    const int stream = m->vertex_count * 24 > STREAM_BYTES;
     size_t batch_start = begin;
     for (size_t b = begin; b < end; b++) {
         const uint32_t *tv = m->tet_vertices + 4 * POSE__BLOCK * b;
@@ -249,7 +253,7 @@ size_t POSE__KV(pose__transfer_blocks)(const pose__transfer_mesh *m, const float
         const pose__v8f px = v0x + (b1 * e1x + b2 * e2x + b3 * e3x);
         const pose__v8f py = v0y + (b1 * e1y + b2 * e2y + b3 * e3y);
         const pose__v8f pz = v0z + (b1 * e1z + b2 * e2z + b3 * e3z);
-        store_lanes(pos, b, m->vertex_count, &px, &py, &pz, 1);
+        store_lanes(pos, b, m->vertex_count, &px, &py, &pz, stream);
         if (!nrm)
             continue;
         const int16_t *kb = m->normal_key + 3 * POSE__BLOCK * b;
@@ -276,7 +280,8 @@ size_t POSE__KV(pose__transfer_blocks)(const pose__transfer_mesh *m, const float
                     flagged[nflagged++] = (uint32_t)(b * POSE__BLOCK + l);
         }
         if (b + 1 - batch_start == TRANSFER_BATCH || b + 1 == end) {
-            store_normals(m, (const pose__v8f(*)[3])raw, batch_start, b + 1 - batch_start, nrm);
+            store_normals(m, (const pose__v8f(*)[3])raw, batch_start, b + 1 - batch_start, nrm,
+                          stream);
             batch_start = b + 1;
         }
     }
