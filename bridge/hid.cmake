@@ -18,3 +18,9 @@ add_executable(pose-hid-mannequin-gen "${CMAKE_CURRENT_SOURCE_DIR}/devices/manne
 target_link_libraries(pose-hid-mannequin-gen PRIVATE pose_bridge)
 target_compile_definitions(pose-hid-mannequin-gen PRIVATE _POSIX_C_SOURCE=200809L)
 pose_target_warnings(pose-hid-mannequin-gen)
+
+# Hardware builders' material: the udev rule for non-root access and its README
+# (copy the rule to /etc/udev/rules.d, see the README).
+install(FILES "${CMAKE_CURRENT_SOURCE_DIR}/devices/70-pose-mannequin.rules"
+              "${CMAKE_CURRENT_SOURCE_DIR}/devices/README.md"
+        DESTINATION "${CMAKE_INSTALL_DATADIR}/pose/devices")
