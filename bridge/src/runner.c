@@ -202,7 +202,10 @@ static void *source_thread(void *arg)
 {
     pb_runner *r = arg;
     apply_priority(r);
-    int64_t t0 = pb_now_ns();
+    /* Media time counts from the first update's own timestamp: live sources
+     * stamp with CLOCK_MONOTONIC, replays with recorded time. */
+    int64_t t0 = 0;
+    int have_t0 = 0;
     for (;;) {
         pthread_mutex_lock(&r->mu);
         int stop = r->stop_req;
@@ -221,6 +224,10 @@ static void *source_thread(void *arg)
         }
         if (got == 0)
             continue;
+        if (!have_t0) {
+            t0 = u.t_ns;
+            have_t0 = 1;
+        }
         pb_chanmap_update(r->cm, &u);
         pb_pose *back = pb_handoff_back(&r->h);
         pb_chanmap_pose(r->cm, back);
