@@ -18,7 +18,7 @@ typedef struct hid_source {
     size_t desc_len;
     uint8_t reopen_desc[PB_HID_MAX_DESC_BYTES]; /* compared with desc_bytes on reopen */
     int open;
-    int64_t last_good_ns;   /* monotonic time of the last good report */
+    int64_t last_rx_ns;     /* monotonic time of the last report, good or not (silence is measured from it) */
     int64_t next_reopen_ns;
     pb_hid_decode_result last_fault;
     int32_t *logical;
@@ -155,7 +155,7 @@ pose_status pb_hid_source_create(pb_hid_transport *t, const pb_hid_source_option
         snprintf(s->base.message, sizeof s->base.message, "%.200s", absent.message);
     else
         snprintf(s->base.message, sizeof s->base.message, "%s: open, no report yet", t->origin);
-    s->last_good_ns = s->next_reopen_ns = pb_hid_now_ns();
+    s->last_rx_ns = s->next_reopen_ns = pb_hid_now_ns();
     *out = &s->base;
     return POSE_OK;
 }
@@ -219,7 +219,7 @@ static int hid_read(pb_source *src, pb_update *out, int timeout_ms)
             if (now >= s->next_reopen_ns) {
                 if (reopen(s) == 0) {
                     s->stats.reopens++;
-                    s->last_good_ns = now;
+                    s->last_rx_ns = now;
                     pb_source_set_state(&s->base, PB_SOURCE_WAITING, "%s: reopened", s->t->origin);
                     continue;
                 }
@@ -233,7 +233,7 @@ static int hid_read(pb_source *src, pb_update *out, int timeout_ms)
         }
         /* Wake in time to flag silence even when the caller waits longer. */
         int64_t wake = deadline;
-        int64_t stale_at = s->last_good_ns + (int64_t)s->opt.stale_ms * 1000000;
+        int64_t stale_at = s->last_rx_ns + (int64_t)s->opt.stale_ms * 1000000;
         if (s->base.state != PB_SOURCE_STALE && stale_at < wake)
             wake = stale_at;
         int wait_ms = wake == INT64_MAX ? -1 : wake <= now ? 0 : (int)((wake - now + 999999) / 1000000);
@@ -255,7 +255,7 @@ static int hid_read(pb_source *src, pb_update *out, int timeout_ms)
         }
         if (n == 0) {
             if (s->base.state != PB_SOURCE_STALE && s->base.state != PB_SOURCE_DISCONNECTED &&
-                now - s->last_good_ns >= (int64_t)s->opt.stale_ms * 1000000)
+                now - s->last_rx_ns >= (int64_t)s->opt.stale_ms * 1000000)
                 pb_source_set_state(&s->base, PB_SOURCE_STALE, "%s: no report for %d ms; holding last values",
                                     s->t->origin, s->opt.stale_ms);
             if (now >= deadline)
@@ -263,6 +263,7 @@ static int hid_read(pb_source *src, pb_update *out, int timeout_ms)
             continue;
         }
         s->report_len = (size_t)n;
+        s->last_rx_ns = now; /* a device sending bad reports is faulty, not silent */
         record_report(s, t_ns);
         uint32_t first, count;
         pb_hid_decode_result r = pb_hid_report_decode(s->desc, s->report, s->report_len, s->logical, s->values,
@@ -274,7 +275,6 @@ static int hid_read(pb_source *src, pb_update *out, int timeout_ms)
             continue;
         }
         s->stats.reports++;
-        s->last_good_ns = now;
         if (s->base.state != PB_SOURCE_OK)
             pb_source_set_state(&s->base, PB_SOURCE_OK, "%s: receiving", s->t->origin);
         return deliver(s, out, t_ns, first, count);
@@ -290,7 +290,7 @@ static int hid_seek(pb_source *src, int64_t t_ns)
         return -1;
     if (s->base.state == PB_SOURCE_ENDED)
         pb_source_set_state(&s->base, PB_SOURCE_WAITING, "%s: seeked", s->t->origin);
-    s->last_good_ns = pb_hid_now_ns();
+    s->last_rx_ns = pb_hid_now_ns();
     return 0;
 }
 

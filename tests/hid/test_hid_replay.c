@@ -218,6 +218,36 @@ static void test_faults(void **state)
     pb_source_destroy(src);
 }
 
+/* A device that keeps sending reports with an undeclared ID is faulty, not
+ * silent: one FAULT callback, no STALE, no value ever delivered. */
+static void test_bad_stream_is_fault_not_stale(void **state)
+{
+    (void)state;
+    pb_hid_recording *rec;
+    pb_error err;
+    assert_int_equal(pb_mannequin_recording(PB_MOTION_REACH, 1000, 0.3, 9, &rec, &err), POSE_OK);
+    for (size_t i = 0; i < rec->event_count; i++)
+        rec->data[rec->events[i].offset] = 0x07;
+    pb_hid_replay_options opt = {.source = {.stale_ms = 40}};
+    pb_source *src;
+    assert_int_equal(pb_hid_replay_create(rec, "bad-ids", &opt, &src, &err), POSE_OK);
+    transitions tr = {0};
+    src->on_status = on_status;
+    src->on_status_user = &tr;
+    pb_update u;
+    int r;
+    while ((r = pb_source_read(src, &u, 20)) == 0) {
+    }
+    assert_int_equal(r, -1);
+    assert_int_equal(tr.count, 2);
+    assert_int_equal(tr.states[0], PB_SOURCE_FAULT);
+    assert_non_null(strstr(tr.messages[0], "report ID 7 is not in the descriptor"));
+    assert_int_equal(tr.states[1], PB_SOURCE_ENDED);
+    assert_int_equal(pb_hid_source_get_stats(src).unknown_ids, 300);
+    assert_true(isnan(pb_hid_source_values(src)[0])); /* never a good value */
+    pb_source_destroy(src);
+}
+
 /* Started before the device is plugged in: channels from the expected
  * descriptor, DISCONNECTED until it appears; a device with another
  * descriptor is refused. */
@@ -332,6 +362,7 @@ int main(void)
         cmocka_unit_test(test_invalid),
         cmocka_unit_test(test_decode_matches_generator),
         cmocka_unit_test(test_faults),
+        cmocka_unit_test(test_bad_stream_is_fault_not_stale),
         cmocka_unit_test(test_expected_descriptor),
         cmocka_unit_test(test_hold_pose),
         cmocka_unit_test(test_seek_and_loop),
