@@ -52,11 +52,11 @@ while [ $# -gt 0 ]; do
 done
 
 t0=$(date +%s)
-stage_t=$t0
+stage_t=
 stage() { # <title>: prints the time the previous stage took
     local now
     now=$(date +%s)
-    [ "$stage_t" -ne "$t0" ] && printf '   (%ds)\n' $((now - stage_t))
+    if [ -n "$stage_t" ]; then printf '   (%ds)\n' $((now - stage_t)); fi
     stage_t=$now
     printf '\n== %s\n' "$*"
 }
