@@ -105,15 +105,17 @@ static double tet_volume_centroid(const pp_tetmesh *m, size_t t, double c[3])
     return fabs(det) / 6.0;
 }
 
-int pp_cor_naive(const pp_tetmesh *m, const pp_weights *w, double sigma, float *cor)
+int pp_cor_naive_vertices(const pp_tetmesh *m, const pp_weights *w, double sigma,
+                          const uint32_t *vertices, size_t count, float *cor)
 {
     double inv = 1.0 / (sigma * sigma);
-    sparse_w *tw = malloc(m->tet_count * sizeof *tw);
+    sparse_w *tw = malloc((m->tet_count ? m->tet_count : 1) * sizeof *tw);
     if (!tw)
         return POSE_ERR_OUT_OF_MEMORY;
     for (size_t t = 0; t < m->tet_count; t++)
         tet_mean_weights(m, w, t, &tw[t]);
-    for (size_t v = 0; v < m->vertex_count; v++) {
+    for (size_t i = 0; i < count; i++) {
+        size_t v = vertices ? vertices[i] : i;
         sparse_w wp;
         vertex_weights(w, v, &wp);
         double num[3] = {0}, den = 0;
@@ -128,10 +130,15 @@ int pp_cor_naive(const pp_tetmesh *m, const pp_weights *w, double sigma, float *
                 den += s * vol;
             }
         for (int k = 0; k < 3; k++)
-            cor[3 * v + k] = den > 0 ? (float)(num[k] / den) : m->positions[3 * v + k];
+            cor[3 * i + k] = den > 0 ? (float)(num[k] / den) : m->positions[3 * v + k];
     }
     free(tw);
     return POSE_OK;
+}
+
+int pp_cor_naive(const pp_tetmesh *m, const pp_weights *w, double sigma, float *cor)
+{
+    return pp_cor_naive_vertices(m, w, sigma, NULL, m->vertex_count, cor);
 }
 
 /* ---- pair bins ----------------------------------------------------- */
@@ -245,7 +252,11 @@ typedef struct cor_job {
 } cor_job;
 
 /* Evaluate each cell's pair sums at its mean (a_i, a_j), with the
- * derivatives a vertex needs to correct for its own offset from the mean. */
+ * derivatives a vertex needs to correct for its own offset from the mean.
+ * The pair term is a_i a_j g(a, b) with g = b_i b_j exp(-d²/σ²); the cell
+ * sums g only and each vertex multiplies by its own a_i a_j, because a
+ * vertex with a tiny weight is far (relatively) from its cell's mean and a
+ * linear correction of the product would overshoot. */
 static void *cor_run(void *arg)
 {
     cor_job *job = arg;
@@ -253,7 +264,7 @@ static void *cor_run(void *arg)
     const double k2 = 2 * c->inv_sigma2;
     for (size_t k = job->begin; k < job->end; k++) {
         const bin_acc *cell = &c->cells[k];
-        const double ai = cell->vb[0] / cell->v, aj = cell->vb[1] / cell->v, aa = ai * aj;
+        const double ai = cell->vb[0] / cell->v, aj = cell->vb[1] / cell->v;
         uint64_t p = cell->key >> 40;
         const bin *b = c->bins + c->pair_start[p], *e = c->bins + c->pair_start[p + 1];
         double r[CELL_RESULT] = {0};
@@ -262,17 +273,16 @@ static void *cor_run(void *arg)
             const double bi = b->b[0], bj = b->b[1], bb = bi * bj;
             const double d = ai * bj - bi * aj;
             const double x = exp(-d * d * c->inv_sigma2);
-            const double E = aa * x, f = E * bb;
-            /* ∂f/∂b (first-order bin moments) and ∂f/∂a (vertex offsets). */
-            const double gi = E * (bj + k2 * bb * aj * d), gj = E * (bi - k2 * bb * ai * d);
-            const double fi = bb * aj * x * (1 - k2 * ai * d * bj);
-            const double fj = bb * ai * x * (1 + k2 * aj * d * bi);
+            const double g = bb * x;
+            /* ∂g/∂b (first-order bin moments) and ∂g/∂a (vertex offsets). */
+            const double gi = x * (bj + k2 * bb * aj * d), gj = x * (bi - k2 * bb * ai * d);
+            const double fi = -k2 * g * d * bj, fj = k2 * g * d * bi;
             for (int q = 0; q < 3; q++) {
-                r[q] += f * b->vc[q] + gi * b->m[0][q] + gj * b->m[1][q];
+                r[q] += g * b->vc[q] + gi * b->m[0][q] + gj * b->m[1][q];
                 r[4 + q] += fi * b->vc[q];
                 r[8 + q] += fj * b->vc[q];
             }
-            r[3] += f * b->v;
+            r[3] += g * b->v;
             r[7] += fi * b->v;
             r[11] += fj * b->v;
         }
@@ -466,9 +476,10 @@ int pp_cor_compute(const pp_tetmesh *m, const pp_weights *w, const pp_cor_option
                 const bin_acc *a = table_get(&tab, cell_key((uint32_t)p, s.w[x], s.w[y], inv_step, v));
                 const double *r = result + CELL_RESULT * (size_t)(a - tab.acc);
                 double di = s.w[x] - a->vb[0] / a->v, dj = s.w[y] - a->vb[1] / a->v;
+                double aa = s.w[x] * s.w[y];
                 for (int q = 0; q < 3; q++)
-                    num[q] += r[q] + di * r[4 + q] + dj * r[8 + q];
-                den += r[3] + di * r[7] + dj * r[11];
+                    num[q] += aa * (r[q] + di * r[4 + q] + dj * r[8 + q]);
+                den += aa * (r[3] + di * r[7] + dj * r[11]);
             }
         for (int q = 0; q < 3; q++)
             cor[3 * v + q] = s.n >= 2 && den > 0 ? (float)(num[q] / den) : m->positions[3 * v + q];

@@ -52,5 +52,9 @@ int pp_cor_compute(const pp_tetmesh *mesh, const pp_weights *w, const pp_cor_opt
 
 /** The direct O(vertices x tets) formula, for tests and small meshes. */
 int pp_cor_naive(const pp_tetmesh *mesh, const pp_weights *w, double sigma, float *cor);
+/** The direct formula for `count` chosen vertices (cor[3 * i] for vertices[i]);
+ *  vertices = NULL means 0..count-1. For spot checks on large meshes. */
+int pp_cor_naive_vertices(const pp_tetmesh *mesh, const pp_weights *w, double sigma,
+                          const uint32_t *vertices, size_t count, float *cor);
 
 #endif /* POSE_PP_COR_FAST_H */

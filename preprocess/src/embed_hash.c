@@ -171,8 +171,8 @@ static void corners(const pp_tetmesh *m, uint32_t t, double c[4][3])
             c[i][k] = m->positions[3 * (size_t)m->tets[4 * (size_t)t + i] + k];
 }
 
-/* The candidate tet containing p with the largest minimum coordinate
- * (most inside), restricted to `label` when >= 0. */
+/* The first candidate tet containing p, restricted to `label` when >= 0;
+ * failing that, one within INSIDE_EPS (the most inside). */
 static int find_inside(const pp_tet_hash *h, const double p[3], int label, uint32_t *tet,
                        double bary[4])
 {
@@ -194,6 +194,8 @@ static int find_inside(const pp_tet_hash *h, const double p[3], int label, uint3
             *tet = t;
             memcpy(bary, w, sizeof w);
             found = 1;
+            if (mn >= 0)
+                break; /* inside: exact; tets sharing a face would give the same point */
         }
     }
     return found;
