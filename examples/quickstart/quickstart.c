@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0
  * quickstart.c: load a rig, bend one joint, pose the whole anatomy and see
- * how far each tissue moved. Build: cc quickstart.c $(pkg-config --cflags --libs pose)
- * Run:   ./quickstart patient.rig [JOINT] */
+ * how far each tissue moved.
+ * Build: cc quickstart.c $(pkg-config --cflags --libs pose) -lm
+ * Run:   ./a.out patient.rig [JOINT] */
 #include <math.h>
 #include <stdio.h>
 
@@ -40,6 +41,7 @@ int main(int argc, char **argv)
         pose_set_method(st, POSE_DQS);
     pose_apply(st);
 
+    int still = 0;
     for (int t = 0; t < (int)pose_rig_tissue_count(rig); t++) {
         pose_tissue_info tissue;
         size_t n;
@@ -51,8 +53,13 @@ int main(int argc, char **argv)
                    dz = xyz[v + 2] - tissue.rest_positions[v + 2];
             moved = fmax(moved, sqrt(dx * dx + dy * dy + dz * dz));
         }
-        printf("%s bent 60 deg: tissue %s (%zu vertices) moved up to %.4f\n", info.name, tissue.name, n, moved);
+        if (moved > 1e-4)
+            printf("%s bent 60 deg: tissue %s (%zu vertices) moved up to %.4f\n", info.name, tissue.name, n,
+                   moved);
+        else
+            still++;
     }
+    printf("%d other tissues did not move\n", still);
     pose_state_free(st);
     pose_rig_free(rig);
     return 0;
