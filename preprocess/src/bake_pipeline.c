@@ -406,7 +406,7 @@ int pp_bake(const pp_bake_options *o, pp_bake_report *rep, char *err, size_t n)
             rc = fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory for CoR");
             goto done;
         }
-        pp_cor_options co = {.threads = threads};
+        pp_cor_options co = {.threads = threads, .tolerance = o->cor_step};
         rc = pp_cor_compute(&s.tet, &s.w, &co, s.cor, &rep->cor, err, n);
         if (rc < 0)
             goto done;

@@ -50,6 +50,7 @@ typedef struct pp_bake_options {
     unsigned influences;            /**< K; 0 = 4 */
     int threads;                    /**< 0 = 1 */
     int no_cor;                     /**< skip CoR (rig without the CoR method) */
+    double cor_step;                /**< CoR weight-bin step (pp_cor_options.tolerance) */
     /** Called at each stage's start (fraction_done of the whole bake) and end. */
     void (*progress)(pp_bake_stage stage, int finished, double fraction_done, void *user);
     void *user;

@@ -162,6 +162,16 @@ static int read_names(const parse_ctx *c, const char *joint, const char *field, 
     return POSE_OK;
 }
 
+/* cJSON keeps repeated keys; a repeated key is almost always a paste error. */
+static const char *repeated_key(const cJSON *obj)
+{
+    for (const cJSON *e = obj->child; e; e = e->next)
+        for (const cJSON *f = e->next; f; f = f->next)
+            if (strcmp(e->string, f->string) == 0)
+                return e->string;
+    return NULL;
+}
+
 static int in_list(char (*list)[PP_NAME_MAX], size_t n, const char *s)
 {
     for (size_t i = 0; i < n; i++)
@@ -175,6 +185,8 @@ static int parse_limits(const parse_ctx *c, const char *joint, const cJSON *lim,
 {
     if (!cJSON_IsObject(lim))
         return fail_at(c, POSE_ERR_FORMAT, joint, "'limits' must be an object");
+    if (repeated_key(lim))
+        return fail_at(c, POSE_ERR_FORMAT, joint, "key 'limits.%s' appears twice", repeated_key(lim));
     static const char *axes[3] = {"x", "y", "z"};
     for (const cJSON *e = lim->child; e; e = e->next) {
         if (strcmp(e->string, "order") == 0) {
@@ -220,6 +232,9 @@ static int parse_joint(const parse_ctx *c, const cJSON *obj, size_t index, pp_te
         if (strcmp(t->joints[k].name, jn) == 0)
             return fail_at(c, POSE_ERR_INVALID_DATA, jn, "name used twice");
 
+    const char *dup = repeated_key(obj);
+    if (dup)
+        return fail_at(c, POSE_ERR_FORMAT, jn, "key '%s' appears twice", dup);
     j->parent = -1;
     j->contact_mm = default_contact_mm;
     j->axis[1] = 1.0f;
@@ -340,6 +355,10 @@ int pp_template_parse(const char *text, size_t size, const char *source, pp_temp
     int rc = POSE_OK;
     if (!cJSON_IsObject(root)) {
         rc = fail_at(&c, POSE_ERR_FORMAT, NULL, "the top level must be an object");
+        goto done;
+    }
+    if (repeated_key(root)) {
+        rc = fail_at(&c, POSE_ERR_FORMAT, NULL, "top-level key '%s' appears twice", repeated_key(root));
         goto done;
     }
     const cJSON *fmt = cJSON_GetObjectItemCaseSensitive(root, "format");

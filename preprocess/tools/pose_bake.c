@@ -5,7 +5,6 @@
  */
 #include "bake_pipeline.h"
 
-#include <ctype.h>
 #include <dirent.h>
 #include <errno.h>
 #include <stdio.h>
@@ -21,7 +20,7 @@ static void usage(FILE *f)
     fprintf(f,
             "usage: pose-bake --skin SKIN --bones DIR|FILE... --template TEMPLATE.json -o OUT.rig\n"
             "                 [--organs DIR|FILE...] [--resolution MM | --target-vertices N]\n"
-            "                 [--backend lattice|tetgen] [-K N] [--threads N] [--no-cor]\n"
+            "                 [--backend lattice|tetgen] [-K N] [--threads N] [--no-cor] [--cor-step S]\n"
             "                 [--vtu FILE] [--json] [--report FILE] [--quiet]\n"
             "\n"
             "Builds a rig for the pose runtime: fits the template's joints to the bones,\n"
@@ -40,6 +39,8 @@ static void usage(FILE *f)
             "  -K, --influences N     weights kept per vertex, 1..8 (default 4)\n"
             "  --threads N            worker threads for mapping and CoR (default: cores)\n"
             "  --no-cor               skip centres of rotation\n"
+            "  --cor-step S           CoR weight-bin step (default 1/128; smaller is closer to\n"
+            "                         the direct formula and slower: 1/256 ~ 4x)\n"
             "  --vtu FILE             also write the tet mesh, labels and weights for ParaView\n"
             "  --json                 print the report as JSON on stdout\n"
             "  --report FILE          write the JSON report to FILE\n"
@@ -260,6 +261,7 @@ int main(int argc, char **argv)
                              !strcmp(a, "--target-vertices") || !strcmp(a, "--backend") ||
                              !strcmp(a, "-K") || !strcmp(a, "--influences") ||
                              !strcmp(a, "--threads") || !strcmp(a, "--vtu") ||
+                             !strcmp(a, "--cor-step") ||
                              !strcmp(a, "--report"))) {
             fprintf(stderr, "pose-bake: %s needs a value\n", a);
             goto out;
@@ -298,6 +300,14 @@ int main(int argc, char **argv)
             if (parse_uint(argv[++i], a, 1, 64, &u) < 0)
                 goto out;
             o.threads = (int)u;
+        } else if (!strcmp(a, "--cor-step")) {
+            char *end;
+            o.cor_step = strtod(argv[++i], &end);
+            if (*end || !(o.cor_step >= 1e-5 && o.cor_step <= 0.5)) {
+                fprintf(stderr, "pose-bake: --cor-step needs a number in 1e-5..0.5 (got '%s')\n",
+                        argv[i]);
+                goto out;
+            }
         } else if (!strcmp(a, "--no-cor")) {
             o.no_cor = 1;
         } else if (!strcmp(a, "--json")) {
@@ -344,7 +354,12 @@ int main(int argc, char **argv)
             print_summary(&rep, &o);
         if (report_path) {
             FILE *f = fopen(report_path, "w");
-            if (!f || !text || fputs(text, f) < 0 || fclose(f) != 0) {
+            int bad = !f || !text;
+            if (f) {
+                bad |= fputs(text ? text : "", f) < 0;
+                bad |= fclose(f) != 0;
+            }
+            if (bad) {
                 fprintf(stderr, "pose-bake: %s: cannot write the report: %s\n", report_path,
                         strerror(errno));
                 status = 1;

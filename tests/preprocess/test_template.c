@@ -75,6 +75,9 @@ static void test_rejects_malformed(void **state)
         {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
                    "\"colour\": 1}]}",
          POSE_ERR_FORMAT, "t.json:3: joint 'hip': unknown key 'colour'"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"bones\": [\"g\"]}]}",
+         POSE_ERR_FORMAT, "t.json:3: joint 'hip': key 'bones' appears twice"},
         {HEAD "{\"name\": \"0123456789012345678901234567890123456789012345678901234567890123\", "
               "\"rule\": \"root\", \"bones\": [\"p\"]}]}",
          POSE_ERR_FORMAT, "'name' must be a string of 1..63 bytes"},
