@@ -253,20 +253,28 @@ pose_status pp_voxel_inside(const pp_mesh *m, const float origin[3], float spaci
             return s;
     }
     size_t ties = 0;
+    for (size_t i = 0; i < count; i++)
+        ties += inside[i] == 3;
+    /* The exact fallback costs one pass over the triangles per tie; a mesh
+     * that is mostly holes (an open sheet) could make that minutes, so past
+     * a budget ties are taken as inside, which is what a hole in a closed
+     * surface usually hides. */
+    int exact = (double)ties * (double)m->triangle_count <= PP_VOXEL_WINDING_BUDGET;
+    if (ambiguous)
+        *ambiguous = ties;
     for (size_t i = 0; i < count; i++) {
         uint8_t v = inside[i];
-        if (v == 3) {
+        if (v == 3 && !exact) {
+            inside[i] = 1;
+        } else if (v == 3) {
             size_t x = i % (size_t)nx, y = (i / (size_t)nx) % (size_t)ny,
                    z = i / ((size_t)nx * (size_t)ny);
             double p[3] = {o[0] + (double)x * spacing, o[1] + (double)y * spacing,
                            o[2] + (double)z * spacing};
             inside[i] = fabs(winding_number(m, p)) >= 0.5;
-            ties++;
         } else {
             inside[i] = v >= 4;
         }
     }
-    if (ambiguous)
-        *ambiguous = ties;
     return POSE_OK;
 }

@@ -37,6 +37,9 @@ enum {
 #define PP_VOXEL_MAX_COUNT ((size_t)400 * 1000 * 1000)
 #define PP_VOXEL_MIN_SPACING 1e-4f /**< 0.1 mm */
 #define PP_VOXEL_MAX_SPACING 1.0f  /**< 1 m */
+/** Ties x triangles above which ties are taken as inside without the exact
+ * winding number (a mesh that is mostly holes); about a second of work. */
+#define PP_VOXEL_WINDING_BUDGET 2e9
 
 /** What voxelization found and repaired. */
 typedef struct pp_voxel_report {

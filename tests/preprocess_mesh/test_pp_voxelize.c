@@ -200,6 +200,41 @@ static void test_open_mesh_is_solid(void **state)
     pp_mesh_free(&s);
 }
 
+
+static void test_winding_number_ties(void **state)
+{
+    (void)state;
+    /* A cube without its +x, +y and +z faces: from inside, the rays towards
+     * -x, -y, -z see a face and the others escape, so every voxel is a 3:3
+     * tie and the winding number decides. Point reflection through the
+     * centre swaps open and closed faces, so w(p) + w(-p) = 1: exactly half
+     * of a centred, symmetric grid is inside. */
+    float lo[3] = {-0.05f, -0.05f, -0.05f}, hi[3] = {0.05f, 0.05f, 0.05f};
+    pp_mesh box;
+    shape_box(&box, lo, hi);
+    static const uint32_t keep[6] = {0, 1, 4, 5, 8, 9}; /* z-, y-, x- faces */
+    uint32_t tri[18];
+    for (int i = 0; i < 6; i++)
+        memcpy(tri + 3 * i, box.triangles + 3 * keep[i], 3 * sizeof *tri);
+    memcpy(box.triangles, tri, sizeof tri);
+    box.triangle_count = 6;
+    uint8_t in[1000];
+    float o[3] = {-0.045f, -0.045f, -0.045f};
+    size_t amb = 0;
+    assert_int_equal(pp_voxel_inside(&box, o, 0.01f, 10, 10, 10, in, &amb), POSE_OK);
+    assert_int_equal(amb, 1000);
+    size_t n = 0;
+    for (int i = 0; i < 1000; i++) {
+        n += in[i];
+        assert_int_equal(in[i] + in[999 - i], 1); /* index 999 - i is the reflection */
+    }
+    assert_int_equal(n, 500);
+    /* the voxel next to the closed corner is in, the one at the open corner out */
+    assert_int_equal(in[0], 1);
+    assert_int_equal(in[999], 0);
+    pp_mesh_free(&box);
+}
+
 static void test_cylinder_with_bone(void **state)
 {
     (void)state;
@@ -323,6 +358,7 @@ int main(void)
         cmocka_unit_test(test_cube_volume),
         cmocka_unit_test(test_sphere_volume_and_orientation),
         cmocka_unit_test(test_open_mesh_is_solid),
+        cmocka_unit_test(test_winding_number_ties),
         cmocka_unit_test(test_cylinder_with_bone),
         cmocka_unit_test(test_shared_body),
     };
