@@ -432,7 +432,9 @@ int pp_cor_compute(const pp_tetmesh *m, const pp_weights *w, const pp_cor_option
     for (uint32_t p = 0; p < npairs; p++)
         pair_start[p + 1] += pair_start[p];
     free(tab.acc);
-    memset(&tab, 0, sizeof tab);
+    free(tab.keys);
+    free(tab.slot);
+    memset(&tab, 0, sizeof tab); /* reused for the vertex cells */
 
     /* 3. Vertex cells: per pair, vertices with nearby (a_i, a_j) share one
      *    evaluation at their mean, corrected to first order per vertex; the

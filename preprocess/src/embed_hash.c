@@ -6,6 +6,7 @@
 #include <float.h>
 #include <math.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,6 +24,10 @@ struct pp_tet_hash {
 /* Only inside tests that must agree with exact containment: a point on a
  * shared face is inside both tets; either answer is exact. */
 #define INSIDE_EPS 1e-9
+
+/* fmin/fmax are library calls without -ffast-math; these are hot. */
+#define MIN2(a, b) ((a) < (b) ? (a) : (b))
+#define MAX2(a, b) ((a) > (b) ? (a) : (b))
 
 static size_t next_prime(size_t n)
 {
@@ -188,7 +193,7 @@ static int find_inside(const pp_tet_hash *h, const double p[3], int label, uint3
         corners(m, t, c);
         if (!pp_tet_barycentric(p, c[0], c[1], c[2], c[3], w))
             continue;
-        double mn = fmin(fmin(w[0], w[1]), fmin(w[2], w[3]));
+        double mn = MIN2(MIN2(w[0], w[1]), MIN2(w[2], w[3]));
         if (mn >= best) {
             best = mn;
             *tet = t;
@@ -215,13 +220,34 @@ static double find_nearest(const pp_tet_hash *h, const double p[3], int label, i
                 for (long dx = -r; dx <= r; dx++) {
                     if (labs(dx) != r && labs(dy) != r && labs(dz) != r)
                         continue; /* only the shell of ring r */
-                    size_t b = hash_cell(h, c[0] + dx, c[1] + dy, c[2] + dz);
+                    /* Skip a cell that cannot hold anything closer. */
+                    long cc[3] = {c[0] + dx, c[1] + dy, c[2] + dz};
+                    double cell_d = 0;
+                    for (int k = 0; k < 3; k++) {
+                        double lo = (double)cc[k] * h->cell, hi = lo + h->cell;
+                        double g = p[k] < lo ? lo - p[k] : p[k] > hi ? p[k] - hi : 0;
+                        cell_d += g * g;
+                    }
+                    if (cell_d >= best)
+                        continue;
+                    size_t b = hash_cell(h, cc[0], cc[1], cc[2]);
                     for (uint32_t i = h->start[b]; i < h->start[b + 1]; i++) {
                         uint32_t t = h->items[i];
                         if (label >= 0 && m->labels[t] != label)
                             continue;
                         double q[4][3];
                         corners(m, t, q);
+                        /* The box distance bounds the tet distance from below
+                         * and costs a tenth of the exact test. */
+                        double box = 0;
+                        for (int k = 0; k < 3; k++) {
+                            double lo = MIN2(MIN2(q[0][k], q[1][k]), MIN2(q[2][k], q[3][k]));
+                            double hi = MAX2(MAX2(q[0][k], q[1][k]), MAX2(q[2][k], q[3][k]));
+                            double g = p[k] < lo ? lo - p[k] : p[k] > hi ? p[k] - hi : 0;
+                            box += g * g;
+                        }
+                        if (box >= best)
+                            continue;
                         double d = pp_point_tet_dist2(p, q[0], q[1], q[2], q[3]);
                         if (d < best) {
                             best = d;
@@ -255,7 +281,8 @@ static double nearest_brute(const pp_tetmesh *m, const double p[3], uint32_t *te
 typedef struct embed_job {
     const pp_tet_hash *h;
     const float *pts;
-    size_t begin, end;
+    size_t end;
+    atomic_size_t *next; /* shared: the next chunk to take */
     int label;
     int label_rings;
     uint32_t *tet;
@@ -305,11 +332,21 @@ static void embed_one(embed_job *job, size_t i)
         job->bary[4 * i + k] = (float)w[k];
 }
 
+/* Points outside the mesh cost far more than inside ones and come in runs
+ * (a whole skin region), so threads take small chunks in turn. */
+enum { EMBED_CHUNK = 512 };
+
 static void *embed_run(void *arg)
 {
     embed_job *job = arg;
-    for (size_t i = job->begin; i < job->end; i++)
-        embed_one(job, i);
+    for (;;) {
+        size_t begin = atomic_fetch_add(job->next, EMBED_CHUNK);
+        if (begin >= job->end)
+            break;
+        size_t end = begin + EMBED_CHUNK < job->end ? begin + EMBED_CHUNK : job->end;
+        for (size_t i = begin; i < end; i++)
+            embed_one(job, i);
+    }
     return NULL;
 }
 
@@ -329,11 +366,9 @@ int pp_embed_points(const pp_tet_hash *h, const float *pts, size_t n, int prefer
     if (threads > 64)
         threads = 64;
     int started = 0, rc = POSE_OK;
-    for (int i = 0; i < threads; i++) {
-        jobs[i] = (embed_job){h, pts, n * (size_t)i / (size_t)threads,
-                              n * (size_t)(i + 1) / (size_t)threads, prefer_label, rings, tet, bary,
-                              {0}};
-    }
+    atomic_size_t next = 0;
+    for (int i = 0; i < threads; i++)
+        jobs[i] = (embed_job){h, pts, n, &next, prefer_label, rings, tet, bary, {0}};
     for (int i = 1; i < threads; i++) {
         if (pthread_create(&tid[i], NULL, embed_run, &jobs[i]) != 0) {
             /* Run what could not be started on this thread. */
