@@ -167,7 +167,9 @@ static int run(const char *data, const char *tmpl_path, double mm, size_t target
     pp_tet_hash_free(h);
 
     float *cor = malloc(3 * tet.vertex_count * sizeof *cor);
-    pp_cor_options co = {.threads = threads, .tolerance = getenv("BENCH_COR_STEP") ? atof(getenv("BENCH_COR_STEP")) : 0};
+    pp_cor_options co = {.threads = threads,
+                         .tolerance = getenv("BENCH_COR_STEP") ? atof(getenv("BENCH_COR_STEP")) : 0,
+                         .cell_tolerance = getenv("BENCH_COR_CELL") ? atof(getenv("BENCH_COR_CELL")) : 0};
     pp_cor_report cr;
     if (pp_cor_compute(&tet, &w, &co, cor, &cr, err, sizeof err) < 0)
         return die("cor", err);

@@ -15,7 +15,7 @@
 
 /* Expected share of the bake's time per stage, for the overall fraction
  * shown with the progress line (measured on the shared body). */
-static const double stage_share[PP_STAGE_COUNT] = {0.04, 0.02, 0.20, 0.12, 0.30, 0.07, 0.20, 0.05};
+static const double stage_share[PP_STAGE_COUNT] = {0.02, 0.04, 0.02, 0.08, 0.35, 0.10, 0.37, 0.02};
 
 const char *pp_bake_stage_name(pp_bake_stage s)
 {

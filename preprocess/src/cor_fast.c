@@ -340,13 +340,16 @@ int pp_cor_compute(const pp_tetmesh *m, const pp_weights *w, const pp_cor_option
     double step = opt && opt->tolerance != 0 ? opt->tolerance : 1.0 / 128;
     int exact = step < 0;
     double inv_step = exact ? 0 : 1.0 / step;
+    double cstep = opt && opt->cell_tolerance > 0 ? opt->cell_tolerance : step;
+    double inv_cell = exact ? 0 : 1.0 / cstep;
     int threads = opt && opt->threads > 1 ? opt->threads : 1;
     size_t n = m->vertex_count, nt = m->tet_count;
     if (w->vertex_count != n) {
         snprintf(err, err_size, "cor: weights for %zu vertices, mesh has %zu", w->vertex_count, n);
         return POSE_ERR_INVALID_ARGUMENT;
     }
-    if (!exact && !(inv_step >= 1 && inv_step < (double)(1u << Q_BITS))) {
+    if (!exact && !(inv_step >= 1 && inv_step < (double)(1u << Q_BITS) && inv_cell >= 1 &&
+                    inv_cell < (double)(1u << Q_BITS))) {
         snprintf(err, err_size, "cor: bin step %g out of range (%g..1)", step,
                  1.0 / (1u << Q_BITS));
         return POSE_ERR_INVALID_ARGUMENT;
@@ -450,7 +453,7 @@ int pp_cor_compute(const pp_tetmesh *m, const pp_weights *w, const pp_cor_option
                 int32_t p = pair_id[(size_t)s.j[x] * joints + s.j[y]];
                 if (p < 0)
                     continue;
-                bin_acc *a = table_get(&tab, cell_key((uint32_t)p, s.w[x], s.w[y], inv_step, v));
+                bin_acc *a = table_get(&tab, cell_key((uint32_t)p, s.w[x], s.w[y], inv_cell, v));
                 if (!a)
                     goto oom;
                 a->vb[0] += s.w[x];
@@ -475,7 +478,7 @@ int pp_cor_compute(const pp_tetmesh *m, const pp_weights *w, const pp_cor_option
                 int32_t p = pair_id[(size_t)s.j[x] * joints + s.j[y]];
                 if (p < 0)
                     continue;
-                const bin_acc *a = table_get(&tab, cell_key((uint32_t)p, s.w[x], s.w[y], inv_step, v));
+                const bin_acc *a = table_get(&tab, cell_key((uint32_t)p, s.w[x], s.w[y], inv_cell, v));
                 const double *r = result + CELL_RESULT * (size_t)(a - tab.acc);
                 double di = s.w[x] - a->vb[0] / a->v, dj = s.w[y] - a->vb[1] / a->v;
                 double aa = s.w[x] * s.w[y];

@@ -33,6 +33,7 @@ typedef struct pp_cor_options {
     double tolerance; /**< bin step in weight space; 0 = 1/128 (deviation from the direct
                            formula ~2e-5 of the model size on the test bars); < 0 = exact (one bin per
                            distinct weight pair: the direct formula, reordered) */
+    double cell_tolerance; /**< vertex cell step; 0 = tolerance */
     int threads;      /**< <= 1 runs on the caller's thread */
 } pp_cor_options;
 

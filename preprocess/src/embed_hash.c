@@ -25,6 +25,9 @@ struct pp_tet_hash {
  * shared face is inside both tets; either answer is exact. */
 #define INSIDE_EPS 1e-9
 
+/* Vertices this close to the mesh (metres) are on its boundary, not outside. */
+#define ON_SURFACE 1e-6
+
 /* fmin/fmax are library calls without -ffast-math; these are hot. */
 #define MIN2(a, b) ((a) < (b) ? (a) : (b))
 #define MAX2(a, b) ((a) > (b) ? (a) : (b))
@@ -324,8 +327,10 @@ static void embed_one(embed_job *job, size_t i)
         double q[4][3];
         corners(m, t, q);
         pp_tet_barycentric(p, q[0], q[1], q[2], q[3], w);
-        job->rep.outside++;
-        job->rep.max_distance = fmax(job->rep.max_distance, sqrt(d));
+        if (d > ON_SURFACE * ON_SURFACE) { /* not just rounding on the boundary */
+            job->rep.outside++;
+            job->rep.max_distance = fmax(job->rep.max_distance, sqrt(d));
+        }
     }
     job->tet[i] = t;
     for (int k = 0; k < 4; k++)

@@ -24,7 +24,7 @@ typedef struct pp_tet_hash pp_tet_hash;
 
 typedef struct pp_embed_report {
     size_t vertices;
-    size_t outside;          /**< not inside any tet: nearest tet, extrapolated */
+    size_t outside;          /**< more than 1 µm outside every tet: nearest tet, extrapolated */
     double max_distance;     /**< metres, largest distance of an outside vertex */
     size_t label_fallback;   /**< prefer_label asked but no such tet near: any tet used */
     double seconds;
