@@ -142,6 +142,48 @@ static void test_cube_obj_and_stl(void **state)
     assert_int_equal(m.triangle_count, 12);
     assert_near(pp_mesh_volume(&m), 1.0, 1e-6);
 
+    pp_mesh_free(&m);
+
+    /* ASCII PLY, and two OBJ objects merged into one mesh */
+    shape_tmp("unit_box.ply", path, sizeof path);
+    f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f, "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
+               "property float z\nelement face 12\nproperty list uchar int vertex_indices\n"
+               "end_header\n");
+    for (int i = 0; i < 8; i++)
+        fprintf(f, "%g %g %g\n", (double)box.positions[3 * i], (double)box.positions[3 * i + 1],
+                (double)box.positions[3 * i + 2]);
+    for (size_t t = 0; t < 12; t++)
+        fprintf(f, "3 %u %u %u\n", box.triangles[3 * t], box.triangles[3 * t + 1],
+                box.triangles[3 * t + 2]);
+    fclose(f);
+    assert_int_equal(pp_mesh_load(path, &m, err, sizeof err), POSE_OK);
+    assert_int_equal(m.vertex_count, 8);
+    assert_int_equal(m.triangle_count, 12);
+    assert_near(pp_mesh_volume(&m), 1.0, 1e-6);
+    pp_mesh_free(&m);
+    shape_tmp("two_boxes.obj", path, sizeof path);
+    f = fopen(path, "w");
+    assert_non_null(f);
+    for (int b = 0; b < 2; b++) {
+        fprintf(f, "o box%d\n", b);
+        for (int i = 0; i < 8; i++)
+            fprintf(f, "v %g %g %g\n", (double)box.positions[3 * i] + 3.0 * b,
+                    (double)box.positions[3 * i + 1], (double)box.positions[3 * i + 2]);
+        for (size_t t = 0; t < 12; t++)
+            fprintf(f, "f %u %u %u\n", box.triangles[3 * t] + 1 + 8 * b,
+                    box.triangles[3 * t + 1] + 1 + 8 * b, box.triangles[3 * t + 2] + 1 + 8 * b);
+    }
+    fclose(f);
+    assert_int_equal(pp_mesh_load(path, &m, err, sizeof err), POSE_OK);
+    assert_int_equal(m.vertex_count, 16);
+    assert_int_equal(m.triangle_count, 24);
+    assert_near(pp_mesh_volume(&m), 2.0, 1e-6);
+    pp_mesh_free(&m);
+    assert_int_equal(pp_mesh_load(shape_tmp("unit_box.stl", path, sizeof path), &m, err, sizeof err),
+                     POSE_OK);
+
     /* a hole shows up as boundary edges */
     shape_drop_triangles(&m, 1);
     assert_int_equal(pp_mesh_topology_count(&m, &topo), POSE_OK);
