@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-double pp_tet_stiffness(const float *p0, const float *p1, const float *p2, const float *p3,
+double pp_tet_local_stiffness(const float *p0, const float *p1, const float *p2, const float *p3,
                         double k[4][4])
 {
     double d[3][3]; /* columns p1-p0, p2-p0, p3-p0 */
@@ -153,7 +153,7 @@ int pp_laplacian_assemble(const pp_tetmesh *m, const int32_t *free_index, size_t
     for (size_t t = 0; t < m->tet_count; t++) {
         const uint32_t *tv = m->tets + 4 * t;
         double k[4][4];
-        if (pp_tet_stiffness(m->positions + 3 * (size_t)tv[0], m->positions + 3 * (size_t)tv[1],
+        if (pp_tet_local_stiffness(m->positions + 3 * (size_t)tv[0], m->positions + 3 * (size_t)tv[1],
                              m->positions + 3 * (size_t)tv[2], m->positions + 3 * (size_t)tv[3],
                              k) == 0.0)
             continue;

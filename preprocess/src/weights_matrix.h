@@ -36,7 +36,7 @@ int pp_laplacian_assemble(const pp_tetmesh *m, const int32_t *free_index, size_t
 void pp_laplacian_free(pp_laplacian *l, cholmod_common *c);
 
 /** Local stiffness of one tet: k[a][b] = V ∇φ_a·∇φ_b; returns V (0 if degenerate). */
-double pp_tet_stiffness(const float *p0, const float *p1, const float *p2, const float *p3,
+double pp_tet_local_stiffness(const float *p0, const float *p1, const float *p2, const float *p3,
                         double k[4][4]);
 
 #endif /* POSE_PP_WEIGHTS_MATRIX_H */
