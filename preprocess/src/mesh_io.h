@@ -7,6 +7,9 @@
  * triangles (repeated index, zero area) dropped. Coordinates are taken as
  * metres; no unit conversion is done.
  *
+ * Threads: pp_mesh_load is not reentrant (Assimp's C API keeps its last
+ * error in a global); load from one thread. The other functions are.
+ *
  * Errors: every function returns a pose_status and, on failure, writes a
  * one-line message naming the file into err (if err != NULL), e.g.
  * "data/skin.obj: no triangles" or "x.stl: vertex 12 has a non-finite
