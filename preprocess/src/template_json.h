@@ -3,7 +3,24 @@
  * Skeleton templates: which joints a body has, their hierarchy, the bone
  * meshes forming each joint's segment, how each joint centre is found from
  * the bones (the fitting rule) and default joint limits. Read from JSON
- * (cJSON); see preprocess/templates/full_body.json for the format.
+ * (cJSON); preprocess/templates/full_body.json is the full example.
+ *
+ *   { "format": "pose-skeleton-template", "version": 1, "name": "...",
+ *     "contact_mm": 5,                      default contact distance
+ *     "joints": [ {                         parents before children
+ *       "name": "knee_r",                   1..63 bytes, unique
+ *       "parent": "hip_r",                  or null for the root
+ *       "rule": "hinge",                    root | ball | hinge | spine | fixed
+ *       "bones": ["r_tibia", "r_fibula"],   mesh names (file stems) of the segment
+ *       "contact": ["r_tibia"],             optional: child bones in the contact
+ *       "parent_contact": ["r_femur"],      optional: parent bones in the contact
+ *       "fit": "parent",                    child | parent | both: surface fitted
+ *       "contact_mm": 10, "grow_mm": 35,    contact distance; optional growth
+ *       "axis": [0, 1, 0], "up": [0, 0, 1], approximate frame y and z (model space)
+ *       "at": [x, y, z],                    fixed centre (rule fixed; root optional)
+ *       "limits": {"order": "XYZ", "y": [0, 150]},  degrees about frame axes
+ *       "comment": "..." } ] }
+ * Unknown or repeated keys are errors, so typos do not pass silently.
  */
 #ifndef POSE_PP_TEMPLATE_JSON_H
 #define POSE_PP_TEMPLATE_JSON_H
