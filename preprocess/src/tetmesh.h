@@ -52,7 +52,11 @@ typedef struct pp_tet_options {
                                   boundaries, leaves up to 2^grading cells wide (0: default,
                                   PP_TET_DEFAULT_GRADING; 1..PP_TET_MAX_GRADING; negative:
                                   uniform Kuhn lattice, one cell per leaf everywhere) */
-    int no_snap;             /**< keep the staircase boundary (for tests) */
+    int no_snap;             /**< keep the staircase boundary. With grading < 0 every dihedral
+                                  angle is 45-90 deg, the FEM Laplacian is an M-matrix and
+                                  harmonic weights cannot go negative; snapping makes ~10 %
+                                  of the edges' entries positive (weights down to about
+                                  -0.07 on the shared body) in exchange for the true skin */
     int verbose;             /**< TetGen: print its own log to stdout */
 } pp_tet_options;
 
