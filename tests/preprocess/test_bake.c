@@ -230,7 +230,21 @@ static void check_knee_bend(pose_method method)
         }
     }
     assert_int_equal(bad, 0);
-    assert_true(tibia_max_move > 0.3); /* the foot really swung back */
+    assert_true(tibia_max_move > 0.3);
+    /* +y flexes the knee: the ankle swings backwards (-X) and up (+Z). */
+    {
+        int t = pose_rig_find_tissue(rig, "r_talus");
+        pose_tissue_info ti;
+        assert_int_equal(pose_rig_tissue_info(rig, t, &ti), POSE_OK);
+        size_t nt;
+        const float *p = pose_tissue_positions(st, t, &nt);
+        double dx = 0, dz = 0;
+        for (size_t v = 0; v < nt; v++) {
+            dx += (p[3 * v] - ti.rest_positions[3 * v]) / (double)nt;
+            dz += (p[3 * v + 2] - ti.rest_positions[3 * v + 2]) / (double)nt;
+        }
+        assert_true(dx < -0.3 && dz > 0.3);
+    }
 
     /* The left leg's bones do not move at all. */
     static const char *left[] = {"l_femur", "l_patella", "l_tibia", "l_fibula", "l_talus", "l_foot", "l_bofoot"};
