@@ -149,14 +149,17 @@ static void test_small_bake_succeeds(void **state)
     write_text("t2.json", "{\"format\": \"pose-skeleton-template\", \"version\": 1, \"joints\": [\n"
                           "{\"name\": \"root\", \"parent\": null, \"rule\": \"root\", \"bones\": [\"upper\"]},\n"
                           "{\"name\": \"knee\", \"parent\": \"root\", \"rule\": \"spine\", \"bones\": [\"lower2\"]}]}\n");
-    char sp[1024], tp[1024], out[1024], b1[1024], b2[1024];
+    /* A bone mesh the template does not name is kept as soft tissue. */
+    write_box("cartilage.obj", (double[]){0.04, 0.04, 0.3}, (double[]){0.06, 0.06, 0.32});
+    char sp[1024], tp[1024], out[1024], b1[1024], b2[1024], b3[1024];
     path_of(sp, sizeof sp, "skin.obj");
     path_of(tp, sizeof tp, "t2.json");
     path_of(out, sizeof out, "small.rig");
     path_of(b1, sizeof b1, "upper.obj");
     path_of(b2, sizeof b2, "lower2.obj");
-    const char *bv[] = {b1, b2};
-    pp_bake_options o = {.skin_path = sp, .bone_paths = bv, .bone_count = 2, .template_path = tp,
+    path_of(b3, sizeof b3, "cartilage.obj");
+    const char *bv[] = {b1, b2, b3};
+    pp_bake_options o = {.skin_path = sp, .bone_paths = bv, .bone_count = 3, .template_path = tp,
                          .output_path = out, .resolution_mm = 10, .threads = 2};
     pp_bake_report rep;
     char err[1024];
@@ -165,11 +168,18 @@ static void test_small_bake_succeeds(void **state)
         fail_msg("%s", err);
     /* Spine rule: centroid of the contact faces at z = 0.22. */
     assert_true(fabs(rep.fits[1].centre[2] - 0.2195) < 1e-3);
+    assert_int_equal(rep.soft_bones, 1);
+    assert_int_equal(rep.tissue_count, 4);
+    assert_int_equal(rep.tissues[3].joint, -1);
+    assert_int_equal(rep.tissues[3].kind, POSE_TISSUE_BONE);
+    assert_int_equal(rep.tissues[1].joint, 0);
+    assert_int_equal(rep.tissues[2].joint, 1);
     pp_bake_report_free(&rep);
     pose_rig *rig;
     assert_int_equal(pose_rig_load(out, &rig), POSE_OK);
     assert_int_equal(pose_rig_joint_count(rig), 2);
-    assert_int_equal(pose_rig_tissue_count(rig), 3);
+    assert_int_equal(pose_rig_tissue_count(rig), 4);
+    assert_true(pose_rig_find_tissue(rig, "cartilage") == 3);
     pose_rig_free(rig);
 }
 
