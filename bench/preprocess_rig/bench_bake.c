@@ -6,12 +6,16 @@
  * peak memory is its own.
  *
  *   bench_preprocess_rig [--data DIR] [--template FILE] [--threads N]
- *                        [--tissue-vertices N] [--cor-check N] CONFIG...
+ *                        [--tissue-vertices N] [--cor-check N] [--compare-backends MM]
+ *                        CONFIG...
  *   CONFIG = MM (voxel edge, one lattice cell per voxel) or MM:VERTICES
  *            (voxel edge, lattice coarsened to a vertex budget)
  *
  * --tissue-vertices N maps N points (the tissue vertices repeated with a
  * sub-millimetre jitter) to measure mapping at the paper's 1.3 M scale.
+ * --compare-backends MM bakes with the lattice and TetGen at MM, poses both
+ * rigs alike and prints time, size, quality, weight bounds and the posed
+ * skin difference.
  * --cor-check N compares the fast CoR with the direct formula on N random
  * tet vertices and prints the largest deviation.
  */
@@ -222,6 +226,110 @@ static int run(const char *data, const char *tmpl_path, double mm, size_t target
     return 0;
 }
 
+/* Bake with each backend at the same voxel size, pose both rigs the same
+ * way and compare: time, tets, quality, weight bounds, and how far the
+ * posed skins differ (same skin vertices, different tet meshes). */
+static int compare_backends(const char *data, const char *tmpl, double mm, int threads)
+{
+    char skin[1024], dir[1024], rigs[2][64];
+    snprintf(skin, sizeof skin, "%s/anatomy/skin.obj", data);
+    snprintf(dir, sizeof dir, "%s/anatomy/bones", data);
+    DIR *d = opendir(dir);
+    if (!d)
+        return die(dir, "cannot open");
+    char **paths = calloc(256, sizeof *paths);
+    size_t nb = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) && nb < 256) {
+        size_t len = strlen(e->d_name);
+        if (len < 5 || strcmp(e->d_name + len - 4, ".obj"))
+            continue;
+        paths[nb] = malloc(strlen(dir) + len + 2);
+        sprintf(paths[nb++], "%s/%s", dir, e->d_name);
+    }
+    closedir(d);
+    const pp_tet_backend backends[2] = {PP_TET_LATTICE, PP_TET_TETGEN};
+    printf("backends at voxel %.1f mm (right knee 90, right elbow 90, left hip -60; skin compared):\n", mm);
+    int rc = 0;
+    for (int b = 0; b < 2 && rc == 0; b++) {
+        snprintf(rigs[b], sizeof rigs[b], "/tmp/bench_rig_%d_%ld.rig", b, (long)getpid());
+        pp_bake_options o = {.skin_path = skin, .bone_paths = (const char *const *)paths,
+                             .bone_count = nb, .template_path = tmpl, .output_path = rigs[b],
+                             .resolution_mm = mm, .backend = backends[b], .threads = threads};
+        pp_bake_report r;
+        char err[1024];
+        if (!pp_tet_backend_available(backends[b])) {
+            printf("  %-8s not built in\n", pp_tet_backend_name(backends[b]));
+            rc = 1;
+            break;
+        }
+        if (pp_bake(&o, &r, err, sizeof err) < 0) {
+            rc = die(pp_tet_backend_name(backends[b]), err);
+        } else {
+            printf("  %-8s %6.1f s (tets %5.1f s, weights %5.1f s, cor %5.1f s), %zu vertices, %zu tets, "
+                   "dihedral %.1f..%.1f, weights %.3f..%.3f, skin outside %zu (max %.1f mm)\n",
+                   pp_tet_backend_name(backends[b]), r.total_seconds,
+                   r.seconds[PP_STAGE_TETRAHEDRALIZE], r.seconds[PP_STAGE_WEIGHTS],
+                   r.seconds[PP_STAGE_COR], r.quality.vertex_count, r.quality.tet_count,
+                   r.quality.min_dihedral_deg, r.quality.max_dihedral_deg, r.weights.min_weight,
+                   r.weights.max_weight, r.tissues[0].outside, r.tissues[0].max_distance * 1e3);
+        }
+        pp_bake_report_free(&r);
+    }
+    for (size_t i = 0; i < nb; i++)
+        free(paths[i]);
+    free(paths);
+    if (rc)
+        return rc;
+    const pose_method methods[3] = {POSE_LBS, POSE_DQS, POSE_COR};
+    for (int mth = 0; mth < 3; mth++) {
+        const float *pos[2];
+        pose_rig *rig[2];
+        pose_state *st[2];
+        size_t n = 0;
+        for (int b = 0; b < 2; b++) {
+            if (pose_rig_load(rigs[b], &rig[b]) != POSE_OK || pose_state_create(rig[b], &st[b]) != POSE_OK)
+                return die("compare", pose_last_error());
+            pose_set_method(st[b], methods[mth]);
+            const float knee[3] = {0, 90, 0}, elbow[3] = {0, 90, 0}, hip[3] = {0, -60, 0};
+            pose_set_joint_euler(st[b], pose_rig_find_joint(rig[b], "knee_r"), knee, POSE_EULER_XYZ);
+            pose_set_joint_euler(st[b], pose_rig_find_joint(rig[b], "elbow_r"), elbow, POSE_EULER_XYZ);
+            pose_set_joint_euler(st[b], pose_rig_find_joint(rig[b], "hip_l"), hip, POSE_EULER_XYZ);
+            pose_apply(st[b]);
+            pos[b] = pose_tissue_positions(st[b], pose_rig_find_tissue(rig[b], "skin"), &n);
+        }
+        /* Over the skin vertices the pose moved (> 1 mm with the lattice rig). */
+        pose_tissue_info si;
+        pose_rig_tissue_info(rig[0], pose_rig_find_tissue(rig[0], "skin"), &si);
+        double mx = 0, sum = 0;
+        size_t moved = 0;
+        for (size_t v = 0; v < n; v++) {
+            double d2 = 0, m2 = 0;
+            for (int c = 0; c < 3; c++) {
+                double a = pos[0][3 * v + c], b = pos[1][3 * v + c], r = si.rest_positions[3 * v + c];
+                d2 += (a - b) * (a - b);
+                m2 += (a - r) * (a - r);
+            }
+            if (m2 < 1e-6)
+                continue;
+            moved++;
+            mx = fmax(mx, sqrt(d2));
+            sum += sqrt(d2);
+        }
+        printf("  posed skin, lattice vs tetgen, %s: %zu vertices moved; difference mean %.2f mm, "
+               "max %.1f mm\n", mth == 0 ? "LBS" : mth == 1 ? "DQS" : "CoR", moved,
+               moved ? sum / (double)moved * 1e3 : 0.0, mx * 1e3);
+        for (int b = 0; b < 2; b++) {
+            pose_state_free(st[b]);
+            pose_rig_free(rig[b]);
+        }
+    }
+    remove(rigs[0]);
+    remove(rigs[1]);
+    fflush(stdout);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     const char *data = POSE_BENCH_DATA, *tmpl = POSE_BENCH_TEMPLATE;
@@ -235,6 +343,9 @@ int main(int argc, char **argv)
             tmpl = argv[++i];
         } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
             threads = atoi(argv[++i]);
+        } else if (!strcmp(argv[i], "--compare-backends") && i + 1 < argc) {
+            configs++;
+            status |= compare_backends(data, tmpl, atof(argv[++i]), threads);
         } else if (!strcmp(argv[i], "--cor-check") && i + 1 < argc) {
             cor_check = (size_t)atol(argv[++i]);
         } else if (!strcmp(argv[i], "--tissue-vertices") && i + 1 < argc) {
