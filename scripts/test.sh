@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs dependencies, builds pose from scratch and runs the whole test
-# suite: a normal build (gcc), then the suite again under ASan+UBSan, then the
-# threaded tests under TSan. Exits non-zero on any failure.
+# suite: a normal build with gcc, then the suite again built with clang under
+# ASan+UBSan, then the threaded tests under TSan. Warnings are errors in every
+# build, so both compilers are checked. Exits non-zero on any failure.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 jobs=$(nproc)
@@ -9,7 +10,7 @@ bash "$root/scripts/install-deps.sh"
 
 run_suite() { # <build dir> <label filter or ""> <cmake args...>
   local dir=$1 filter=$2; shift 2
-  cmake -S "$root" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPOSE_BUILD_BENCH=OFF "$@" >/dev/null
+  CC=${CC:-cc} CXX=${CXX:-c++} cmake -S "$root" -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPOSE_BUILD_BENCH=OFF "$@" >/dev/null
   cmake --build "$dir" -j "$jobs"
   if [ -n "$filter" ]; then
     ctest --test-dir "$dir" --output-on-failure -j "$jobs" -L "$filter"
@@ -18,9 +19,9 @@ run_suite() { # <build dir> <label filter or ""> <cmake args...>
   fi
 }
 
-echo "== build and test (gcc, RelWithDebInfo)"
-run_suite "$root/build" ""
-echo "== test under ASan+UBSan"
-run_suite "$root/build-asan" "" -DPOSE_SANITIZE=ON -DPOSE_BUILD_EXAMPLES=OFF
+echo "== build (gcc, RelWithDebInfo, with benchmarks) and test"
+run_suite "$root/build" "" -DPOSE_BUILD_BENCH=ON   # benchmarks are built (not run) so they keep compiling
+echo "== build with clang and test under ASan+UBSan"
+CC=clang CXX=clang++ run_suite "$root/build-asan" "" -DPOSE_SANITIZE=ON
 echo "== threaded tests under TSan"
-run_suite "$root/build-tsan" "threads" -DPOSE_TSAN=ON -DPOSE_BUILD_EXAMPLES=OFF -DPOSE_BUILD_PREPROCESS=OFF
+run_suite "$root/build-tsan" "threads" -DPOSE_TSAN=ON -DPOSE_BUILD_EXAMPLES=OFF
