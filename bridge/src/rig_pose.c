@@ -3,6 +3,7 @@
  * rig's skeleton, and applying a pose. Kept apart so that everything else
  * in the bridge links without libpose. */
 #include <stdlib.h>
+#include <string.h>
 
 #include "bridge_apply.h"
 #include "pb_math.h"
@@ -26,6 +27,10 @@ pose_status pb_rig_skel_from_rig(const pose_rig *rig, pb_rig_skel **out, pb_erro
         d[j].name = info.name;
         d[j].parent = info.parent;
         d[j].rest_model = info.rest_model;
+        d[j].limit_flags = info.limit_flags;
+        d[j].limit_order = info.limit_order;
+        memcpy(d[j].limit_min_deg, info.limit_min_deg, sizeof d[j].limit_min_deg);
+        memcpy(d[j].limit_max_deg, info.limit_max_deg, sizeof d[j].limit_max_deg);
     }
     pose_status s = pb_rig_skel_from_desc(d, n, out, err);
     free(d);

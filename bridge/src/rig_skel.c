@@ -75,6 +75,11 @@ pose_status pb_rig_skel_from_desc(const pose_joint_desc *joints, size_t count, p
         pb_quat_normalize(J->rest_q);
         for (int k = 0; k < 3; k++)
             J->rest_p[k] = joints[j].rest_model.translation[k];
+        J->limit_flags = joints[j].limit_flags;
+        for (int k = 0; k < 3; k++) {
+            J->limit_min_deg[k] = joints[j].limit_min_deg[k];
+            J->limit_max_deg[k] = joints[j].limit_max_deg[k];
+        }
     }
     compute_locals(s);
     *out = s;
@@ -117,6 +122,20 @@ void pb_rig_skel_free(pb_rig_skel *s)
         return;
     free(s->joints);
     free(s);
+}
+
+int pb_rig_skel_hinge_axis(const pb_rig_skel *s, int j, int along)
+{
+    const pb_rig_joint *J = &s->joints[j];
+    if (along < 0 || along > 2 || (J->limit_flags & 7u) != 7u)
+        return -1;
+    int a = (along + 1) % 3, b = (along + 2) % 3;
+    double ra = (double)J->limit_max_deg[a] - J->limit_min_deg[a], rb = (double)J->limit_max_deg[b] - J->limit_min_deg[b];
+    if (ra >= 60.0 && rb <= 30.0)
+        return a;
+    if (rb >= 60.0 && ra <= 30.0)
+        return b;
+    return -1;
 }
 
 int pb_rig_skel_find(const pb_rig_skel *s, const char *name)

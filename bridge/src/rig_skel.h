@@ -8,6 +8,8 @@
 #ifndef POSE_BRIDGE_RIG_SKEL_H
 #define POSE_BRIDGE_RIG_SKEL_H
 
+#include <stdint.h>
+
 #include "mocap.h"
 #include "pose/pose.h"
 
@@ -18,6 +20,8 @@ typedef struct pb_rig_joint {
     double rest_p[3];
     double local_q[4];  /**< rest frame relative to the parent's */
     double local_p[3];
+    uint32_t limit_flags;  /**< POSE_LIMIT_* bits, as in pose_joint_desc (0: none known) */
+    float limit_min_deg[3], limit_max_deg[3];
 } pb_rig_joint;
 
 typedef struct pb_rig_skel {
@@ -25,7 +29,7 @@ typedef struct pb_rig_skel {
     pb_rig_joint *joints;
 } pb_rig_skel;
 
-/** From joint descriptions (rest_model per joint), as in pose_rig_desc. */
+/** From joint descriptions (rest_model and limits per joint), as in pose_rig_desc. */
 pose_status pb_rig_skel_from_desc(const pose_joint_desc *joints, size_t count, pb_rig_skel **out, pb_error *err);
 /** From a loaded rig (pose_rig_joint_info). */
 pose_status pb_rig_skel_from_rig(const pose_rig *rig, pb_rig_skel **out, pb_error *err);
@@ -35,6 +39,14 @@ pose_status pb_rig_skel_from_rig(const pose_rig *rig, pb_rig_skel **out, pb_erro
  */
 pose_status pb_rig_skel_from_clip(const pb_clip *clip, double scale, pb_rig_skel **out, pb_error *err);
 void pb_rig_skel_free(pb_rig_skel *s);
+/**
+ * The hinge axis of joint j read from its limits (0 x, 1 y, 2 z), or -1: the
+ * joint is a hinge when, of its two axes other than `along` (the local axis
+ * nearest its segment, which carries twist), one may turn by 60 degrees or
+ * more and the other by 30 or less. A knee (x -5..5, y 0..150, twist z) is a
+ * hinge about y; a hip or a joint without limits is not.
+ */
+int pb_rig_skel_hinge_axis(const pb_rig_skel *s, int j, int along);
 int pb_rig_skel_find(const pb_rig_skel *s, const char *name);
 /**
  * Model-space joint frames for local rotations q (relative to rest, NULL =
