@@ -342,19 +342,25 @@ pose_status pb_runner_start_clip(const pb_clip *clip, const pb_rig_skel *rig, co
 pose_status pb_runner_start_source(pb_source *src, const pb_rig_skel *rig, const pb_mapping *map,
                                    const pb_runner_options *opt, pb_runner **out, pb_error *err)
 {
-    if (!src || !rig || !map || !out)
+    /* The source is ours from here on, whatever happens: the caller never
+     * has to guess which failures left it alive. */
+    if (!src || !rig || !map || !out) {
+        pb_source_destroy(src);
         return pb_fail(err, POSE_ERR_INVALID_ARGUMENT, "pb_runner_start_source: NULL argument");
+    }
     *out = NULL;
     pb_runner *r;
     pose_status s = runner_new(rig, opt, 0.01, &r, err);
-    if (s)
+    if (s) {
+        pb_source_destroy(src);
         return s;
+    }
+    r->src = src; /* runner_free destroys it on the failures below */
     s = pb_chanmap_create(map, src->channels, src->channel_count, rig, &r->cm, err);
     if (s) {
         runner_free(r);
         return s;
     }
-    r->src = src;
     r->stats.state = PB_SOURCE_OK;
     return runner_launch(r, source_thread, out, err);
 }

@@ -55,8 +55,11 @@ typedef struct pb_runner pb_runner;
 pose_status pb_runner_start_clip(const pb_clip *clip, const pb_rig_skel *rig, const pb_mapping *map,
                                  const pb_runner_options *opt, pb_runner **out, pb_error *err);
 /**
- * Start a thread that reads `src` (scalar channels; takes ownership and
- * destroys it at stop) and maps it through map's "channels" onto `rig`.
+ * Start a thread that reads `src` (scalar channels) and maps it through
+ * map's "channels" onto `rig`. Always takes ownership of `src`: on success
+ * pb_runner_stop destroys it, on any failure (NULL arguments included) it is
+ * destroyed before this returns. Either way the caller must not use or
+ * destroy it afterwards.
  */
 pose_status pb_runner_start_source(pb_source *src, const pb_rig_skel *rig, const pb_mapping *map,
                                    const pb_runner_options *opt, pb_runner **out, pb_error *err);

@@ -201,13 +201,11 @@ int ex_motion_start(ex_motion *m, char *err, size_t err_size)
     pb_runner_options opt = {.speed = 1.0, .loop = 1};
     pose_status st = m->clip ? pb_runner_start_clip(m->clip, m->skel, m->map, &opt, &m->runner, &pe)
                              : pb_runner_start_source(m->src, m->skel, m->map, &opt, &m->runner, &pe);
+    m->src = NULL; /* pb_runner_start_source always takes the source, even when it fails */
     if (st < 0) {
-        if (st == POSE_ERR_THREAD)
-            m->src = NULL; /* the runner had taken it and destroyed it */
         snprintf(err, err_size, "%s", pe.message[0] ? pe.message : "cannot start the bridge thread");
         return -1;
     }
-    m->src = NULL;
     return 0;
 }
 
