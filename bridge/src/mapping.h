@@ -22,9 +22,14 @@
  *   "root_motion": "none" | "horizontal" | "full" (default "none").
  *   "reference": "zero" (all channels 0, default) or a frame number: the clip
  *       pose taken to correspond to the rig's rest pose.
- *   "align": true (default): per joint, rotate the rig's rest bone direction
- *       onto the clip's reference bone direction, so limbs point where the
- *       clip's do even when the two rest poses differ.
+ *   "align": true (default): per joint, bend the rig's rest bone onto the
+ *       clip's reference bone, so limbs point where the clip's do even when
+ *       the two rest poses differ, and turn it about the bone so that the
+ *       rig's hinges (read from their limits) and the clip's (measured from
+ *       its motion) share their axes (retarget.c). Set it false, per joint,
+ *       where the clip's joint positions are schematic rather than a
+ *       posture (CMU's straight spine and mid-chest collars): the segment
+ *       then keeps the rig's rest posture at the clip's reference pose.
  *   "filter": default One Euro parameters for every joint / channel.
  * Without "joints" and "channels", clip joints drive rig joints of the same
  * name (pb_mapping_identity).

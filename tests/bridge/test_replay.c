@@ -305,6 +305,35 @@ static void test_source_runner(void **state)
     pb_mapping_free(m);
 }
 
+/* pb_runner_start_source owns the source whatever happens: every failure
+ * below destroys it (LeakSanitizer reports it otherwise; the sources hold
+ * heap memory), and nothing is started. */
+static void test_source_runner_owns_source_on_failure(void **state)
+{
+    fixture *f = *state;
+    pb_source *src;
+    pb_mapping *m;
+    pb_runner *r = NULL;
+    pb_error err;
+    const char *js = "{\"channels\": [{\"channel\": \"NoSuchJoint.Xrotation\", \"joint\": \"RightElbow\", "
+                     "\"axis\": \"x\"}]}";
+    assert_int_equal(pb_mapping_parse(js, strlen(js), "m.json", &m, &err), POSE_OK);
+    /* an unknown channel: the mapping does not bind */
+    assert_int_equal(pb_mocap_source_open(f->clip, 0.0, 0, &src, &err), POSE_OK);
+    assert_int_equal(pb_runner_start_source(src, f->rig, m, NULL, &r, &err), POSE_ERR_NOT_FOUND);
+    assert_null(r);
+    assert_non_null(strstr(err.message, "NoSuchJoint.Xrotation"));
+    /* a NULL argument */
+    assert_int_equal(pb_mocap_source_open(f->clip, 0.0, 0, &src, &err), POSE_OK);
+    assert_int_equal(pb_runner_start_source(src, NULL, m, NULL, &r, &err), POSE_ERR_INVALID_ARGUMENT);
+    /* a recording that cannot be opened */
+    assert_int_equal(pb_mocap_source_open(f->clip, 0.0, 0, &src, &err), POSE_OK);
+    pb_runner_options o = {.record_path = "/nonexistent-dir/session.bvh"};
+    assert_true(pb_runner_start_source(src, f->rig, m, &o, &r, &err) < 0);
+    assert_null(r);
+    pb_mapping_free(m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -315,6 +344,7 @@ int main(void)
         cmocka_unit_test(test_loop_and_end),
         cmocka_unit_test(test_recording_from_thread),
         cmocka_unit_test(test_source_runner),
+        cmocka_unit_test(test_source_runner_owns_source_on_failure),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
