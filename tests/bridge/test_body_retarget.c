@@ -56,6 +56,19 @@ static const body_case CASES[] = {
       {{"pelvis", "neck"}, {"Hips", "Neck"}}},
      15.0,
      0.06},
+    {"mocap/cmu-asf-amc/01_01.amc",
+     "cmu_asf_to_full_body.json",
+     {{{"hip_r", "knee_r"}, {"rfemur", "rtibia"}},
+      {{"knee_r", "ankle_r"}, {"rtibia", "rfoot"}},
+      {{"hip_l", "knee_l"}, {"lfemur", "ltibia"}},
+      {{"knee_l", "ankle_l"}, {"ltibia", "lfoot"}},
+      {{"shoulder_r", "elbow_r"}, {"rhumerus", "rradius"}},
+      {{"elbow_r", "wrist_r"}, {"rradius", "rwrist"}},
+      {{"shoulder_l", "elbow_l"}, {"lhumerus", "lradius"}},
+      {{"elbow_l", "wrist_l"}, {"lradius", "lwrist"}},
+      {{"pelvis", "neck"}, {"root", "lowerneck"}}},
+     15.0,
+     0.06},
 };
 
 typedef struct fixture {
@@ -195,12 +208,14 @@ static void run_case(const fixture *fx, const body_case *bc)
 
 static void test_walk_131(void **state) { run_case(*state, &CASES[0]); }
 static void test_jumps_01(void **state) { run_case(*state, &CASES[1]); }
+static void test_jumps_01_asf_amc(void **state) { run_case(*state, &CASES[2]); }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_walk_131),
         cmocka_unit_test(test_jumps_01),
+        cmocka_unit_test(test_jumps_01_asf_amc),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
