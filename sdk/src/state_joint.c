@@ -10,6 +10,10 @@
 
 static const char k_axis[3] = {'x', 'y', 'z'};
 
+/* Excess below this many degrees is float noise from the Euler decomposition
+ * (a straight knee reads as y = -0.00), not a request past the limit. */
+#define POSE__LIMIT_TOLERANCE_DEG 1e-3f
+
 static int finite4(const float *v, int n)
 {
     for (int i = 0; i < n; i++)
@@ -45,7 +49,7 @@ static int clamp_angles(const pose_state *st, int j, float deg[3])
             c = lim->min_deg[a];
         if (c > lim->max_deg[a])
             c = lim->max_deg[a];
-        if (c == v)
+        if (fabsf(c - v) <= POSE__LIMIT_TOLERANCE_DEG)
             continue;
         int n = snprintf(msg + len, sizeof msg - len, "%s%c %.2f clamped to %.2f [%.2f, %.2f]",
                          clamped ? ", " : "", k_axis[a], (double)v, (double)c,
@@ -73,6 +77,38 @@ static pose_status check_joint(const pose_state *st, int joint, const void *ptr,
     return POSE_OK;
 }
 
+/* Degrees by which angles {x, y, z} lie outside the limits, summed over axes. */
+static float limit_excess(const pose__joint_limit *lim, const float deg[3])
+{
+    float e = 0.0f;
+    for (int a = 0; a < 3; a++) {
+        if (!(lim->flags & (1u << a)))
+            continue;
+        if (deg[a] < lim->min_deg[a])
+            e += lim->min_deg[a] - deg[a];
+        else if (deg[a] > lim->max_deg[a])
+            e += deg[a] - lim->max_deg[a];
+    }
+    return e;
+}
+
+/* Every rotation has two Tait-Bryan triples in an order ABC: (a, b, c) and
+ * (a + 180, 180 - b, c + 180). The decomposition returns the one with the
+ * middle angle in [-90, 90]; take the other when it is closer to the limits,
+ * so that e.g. a knee bent 120 degrees about a middle axis is read as a bend
+ * rather than as the two other axes turned by 180 degrees. */
+static void euler_nearest_limits(const pose__joint_limit *lim, float deg[3])
+{
+    int axes[3];
+    pose__euler_axes((int)lim->order, axes);
+    float alt[3];
+    alt[axes[0]] = wrap_deg(deg[axes[0]] + 180.0f);
+    alt[axes[1]] = wrap_deg(180.0f - deg[axes[1]]);
+    alt[axes[2]] = wrap_deg(deg[axes[2]] + 180.0f);
+    if (limit_excess(lim, alt) < limit_excess(lim, deg))
+        memcpy(deg, alt, sizeof alt);
+}
+
 pose_status pose__state_store_joint(pose_state *st, int joint, float q[4])
 {
     pose_status s = POSE_OK;
@@ -80,6 +116,7 @@ pose_status pose__state_store_joint(pose_state *st, int joint, float q[4])
     if (lim->flags & (POSE_LIMIT_X | POSE_LIMIT_Y | POSE_LIMIT_Z)) {
         float deg[3];
         pose__quat_to_euler(q, (int)lim->order, deg);
+        euler_nearest_limits(lim, deg);
         if (clamp_angles(st, joint, deg)) {
             pose__euler_to_quat(deg, (int)lim->order, q);
             s = POSE_CLAMPED;

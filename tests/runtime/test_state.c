@@ -305,6 +305,38 @@ static void test_euler_orders(void **unused)
     pose_rig_free(rig);
 }
 
+/* A bend past 90 degrees about the middle axis of the limits' order is read
+ * as a bend (the decomposition's other triple), not as the two other axes
+ * turned by 180 and clamped; excess within float noise is no clamp. */
+static void test_limits_bend_past_90(void **unused)
+{
+    (void)unused;
+    fx_options o = fx_defaults();
+    o.limit_joint = 1;
+    o.limit_order = POSE_EULER_XYZ; /* y is the middle axis */
+    o.limit_flags = POSE_LIMIT_X | POSE_LIMIT_Y | POSE_LIMIT_Z;
+    o.limit_min[0] = -5.0f, o.limit_max[0] = 5.0f;
+    o.limit_min[1] = 0.0f, o.limit_max[1] = 150.0f;
+    o.limit_min[2] = -5.0f, o.limit_max[2] = 5.0f;
+    pose_rig *rig = fx_bar(&o);
+    pose_state *st;
+    assert_int_equal(pose_state_create(rig, &st), POSE_OK);
+    const float h = 0.5f * 120.0f * 3.14159265f / 180.0f;
+    const float bend[4] = {0.0f, sinf(h), 0.0f, cosf(h)};
+    assert_int_equal(pose_set_joint(st, 1, bend), POSE_OK);
+    float got[4];
+    pose_get_joint(st, 1, got);
+    double bd[4] = {bend[0], bend[1], bend[2], bend[3]};
+    assert_true(dq_dist(bd, got) < 1e-6);
+    const float straight[3] = {0.0f, -0.0005f, 0.0f};
+    assert_int_equal(pose_set_joint_euler(st, 1, straight, POSE_EULER_XYZ), POSE_OK);
+    const float past[3] = {0.0f, 160.0f, 0.0f};
+    assert_int_equal(pose_set_joint_euler(st, 1, past, POSE_EULER_XYZ), POSE_CLAMPED);
+    assert_non_null(strstr(pose_last_error(), "clamped to 150.00"));
+    pose_state_free(st);
+    pose_rig_free(rig);
+}
+
 /* Limits clamp requests (Euler in the limits' order and quaternions decomposed
  * in it) for every order, name the axis, and leave in-range requests alone. */
 static void test_limits_clamp(void **unused)
@@ -473,6 +505,7 @@ int main(void)
         cmocka_unit_test(test_world_transforms_compose),
         cmocka_unit_test(test_euler_orders),
         cmocka_unit_test(test_limits_clamp),
+        cmocka_unit_test(test_limits_bend_past_90),
         cmocka_unit_test(test_transfer_on_tet_vertices),
         cmocka_unit_test(test_threads_identical),
         cmocka_unit_test(test_apply_allocates_nothing),
