@@ -94,6 +94,7 @@ char *pp_bake_report_json(const pp_bake_report *r, const pp_bake_options *o)
     cJSON_AddNumberToObject(w, "max_weight", r->weights.max_weight);
     cJSON_AddNumberToObject(w, "max_sum_error", r->weights.max_sum_error);
     cJSON_AddNumberToObject(w, "max_dropped", r->weights.max_dropped);
+    cJSON_AddNumberToObject(w, "clipped_entries", (double)r->weights.clipped_entries);
     cJSON_AddBoolToObject(w, "non_negative", r->weights.min_weight > -1e-6);
     cJSON_AddBoolToObject(w, "bounded", r->weights.max_weight < 1 + 1e-6);
     cJSON_AddBoolToObject(w, "partition_of_unity", r->weights.max_sum_error < 1e-6);

@@ -119,6 +119,31 @@ pose_status pp_cells_label(const pp_voxels *v, double c, pp_cells *L)
     return POSE_OK;
 }
 
+pose_status pp_cells_dilate(pp_cells *L)
+{
+    int m[3] = {L->m[0] + 2, L->m[1] + 2, L->m[2] + 2};
+    uint16_t *cell = calloc((size_t)m[0] * m[1] * m[2], sizeof *cell);
+    if (!cell)
+        return POSE_ERR_OUT_OF_MEMORY;
+    for (int z = 0; z < m[2]; z++)
+        for (int y = 0; y < m[1]; y++)
+            for (int x = 0; x < m[0]; x++) {
+                uint16_t *c = &cell[(size_t)x + (size_t)m[0] * ((size_t)y + (size_t)m[1] * z)];
+                *c = pp_cells_at(L, x - 1, y - 1, z - 1);
+                for (int d = 0; d < 27 && *c == PP_VOXEL_OUTSIDE; d++)
+                    if (pp_cells_at(L, x - 2 + d % 3, y - 2 + d / 3 % 3, z - 2 + d / 9) !=
+                        PP_VOXEL_OUTSIDE)
+                        *c = PP_VOXEL_SOFT;
+            }
+    free(L->cell);
+    L->cell = cell;
+    for (int k = 0; k < 3; k++) {
+        L->m[k] = m[k];
+        L->o[k] -= L->c;
+    }
+    return POSE_OK;
+}
+
 uint16_t pp_cells_at(const pp_cells *L, int x, int y, int z)
 {
     if (x < 0 || y < 0 || z < 0 || x >= L->m[0] || y >= L->m[1] || z >= L->m[2])

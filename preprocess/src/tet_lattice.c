@@ -171,11 +171,14 @@ pose_status pp_tet_lattice(const pp_voxels *vox, const pp_mesh *skin, const pp_t
      * vertices a volume estimate does not see; a graded mesh is mostly
      * surface, so its count goes with the square of the size). */
     pose_status s = POSE_OK;
+    int grow = skin && !opt->no_snap; /* one layer more, snapped inward */
     for (int pass = 0; pass < 4; pass++) {
         pp_tetmesh_free(out);
         free(dir);
         dir = NULL;
         s = pp_cells_label(vox, c, &L);
+        if (s == POSE_OK && grow)
+            s = pp_cells_dilate(&L);
         if (s == POSE_OK)
             s = build(&L, grading, out, &dir);
         if (s != POSE_OK || !opt->target_vertices)
@@ -203,7 +206,8 @@ pose_status pp_tet_lattice(const pp_voxels *vox, const pp_mesh *skin, const pp_t
                 memset(dir + 3 * (size_t)out->tets[4 * t + k], 0, 3);
     if (skin && !opt->no_snap) {
         size_t moved = 0;
-        s = pp_tet_snap(out, skin, dir, (float)(2.0 * cell), &moved);
+        s = pp_tet_snap(out, skin, dir, (float)(PP_SNAP_REACH * cell),
+                        (float)(PP_SNAP_MARGIN * cell), &moved);
         if (s != POSE_OK && err && errlen)
             snprintf(err, errlen, "tetrahedralize: out of memory while snapping");
     }

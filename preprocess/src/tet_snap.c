@@ -16,6 +16,10 @@
 #ifndef PP_SNAP_MIN_SHAPE
 #define PP_SNAP_MIN_SHAPE 0.2
 #endif
+/* Sweeps over the boundary: moves cut short go further in later ones. */
+#ifndef PP_SNAP_SWEEPS
+#define PP_SNAP_SWEEPS 4
+#endif
 
 typedef struct buckets {
     double o[3], b;   /* origin, bucket edge */
@@ -281,9 +285,13 @@ static int closest_point(const pp_mesh *m, const buckets *g, const double p[3], 
  * set in dir: first each of those coordinates moves to the surface along its
  * own axis (so a staircase corner offset by different amounts per axis lands
  * on the surface's corner, and a box is recovered exactly), then the result
- * goes to its closest surface point. Returns 0 when nothing is in reach. */
+ * goes to its closest surface point q, and the target is q moved back
+ * towards p by `margin`. Only inward moves are made (p on the outer side of
+ * q along dir): the staircase starts outside the skin (tet_cells.h) and a
+ * vertex the skin has grown past stays where it is rather than pull the
+ * boundary into the body. Returns 0 when there is nothing to do. */
 static int snap_target(const pp_mesh *m, const buckets *g, const double p[3], const int8_t dir[3],
-                       double reach, double out[3])
+                       double reach, double margin, double out[3])
 {
     double c[3] = {p[0], p[1], p[2]};
     for (int k = 0; k < 3; k++) {
@@ -291,7 +299,20 @@ static int snap_target(const pp_mesh *m, const buckets *g, const double p[3], co
         if (dir[k] && axis_hit(m, g, p, k, reach, &s))
             c[k] = p[k] + s;
     }
-    return closest_point(m, g, c, reach, out);
+    double q[3], u[3];
+    if (!closest_point(m, g, c, reach, q))
+        return 0;
+    sub3(p, q, u);
+    double len = sqrt(dot3(u, u));
+    double along = u[0] * dir[0] + u[1] * dir[1] + u[2] * dir[2];
+    if (!(len > margin))
+        return 0; /* already within the margin */
+    if (!(along > 0.0))
+        return 0;
+    double f = margin / len;
+    for (int k = 0; k < 3; k++)
+        out[k] = q[k] + f * u[k];
+    return 1;
 }
 
 /* Shape quality of a tet with vertex `moved` at np: 6 sqrt(2) V / l_rms^3,
@@ -319,105 +340,102 @@ static double tet_shape(const float *P, const uint32_t *t, uint32_t moved, const
     return 6.0 * sqrt(2.0) * vol / (rms * rms * rms);
 }
 
+/* Try to move vertex v from its position towards np by f = 1, 1/2, 1/4;
+ * a step is taken only when no incident tet falls below the shape bound.
+ * Returns the fraction taken (0 when refused). */
+static double try_move(pp_tetmesh *t, uint32_t v, const double np[3], const size_t *start,
+                       const uint32_t *inc, const double *q0)
+{
+    double p[3] = {t->positions[3 * (size_t)v], t->positions[3 * (size_t)v + 1],
+                   t->positions[3 * (size_t)v + 2]};
+    for (double f = 1.0; f >= 0.25; f *= 0.5) {
+        double x[3];
+        for (int k = 0; k < 3; k++)
+            x[k] = p[k] + f * (np[k] - p[k]);
+        int ok = 1;
+        for (size_t q = start[v]; q < start[v + 1] && ok; q++)
+            ok = tet_shape(t->positions, t->tets + 4 * (size_t)inc[q], v, x) >=
+                 fmin(PP_SNAP_MIN_SHAPE, q0[q]);
+        if (!ok)
+            continue;
+        for (int k = 0; k < 3; k++)
+            t->positions[3 * (size_t)v + k] = (float)x[k];
+        return f;
+    }
+    return 0.0;
+}
+
 pose_status pp_tet_snap(pp_tetmesh *t, const pp_mesh *surface, const int8_t *dir, float reach,
-                        size_t *moved)
+                        float margin, size_t *moved)
 {
     *moved = 0;
     if (!surface || surface->triangle_count == 0)
         return POSE_OK;
     size_t nv = t->vertex_count;
-    /* vertex -> incident tets (only for vertices that may move) */
     size_t *start = calloc(nv + 1, sizeof *start);
-    if (!start)
-        return POSE_ERR_OUT_OF_MEMORY;
-    for (size_t i = 0; i < 4 * t->tet_count; i++) {
-        uint32_t v = t->tets[i];
-        if (dir[3 * (size_t)v] | dir[3 * (size_t)v + 1] | dir[3 * (size_t)v + 2])
-            start[v + 1]++;
-    }
+    float *target = malloc((nv ? nv : 1) * 3 * sizeof *target);
+    uint32_t *inc = NULL;
+    double *q0 = NULL;
+    buckets g = {0};
+    pose_status s = POSE_ERR_OUT_OF_MEMORY;
+    if (!start || !target)
+        goto done;
+    /* vertex -> incident tets, for the boundary vertices */
+#define ON_BOUNDARY(v) (dir[3 * (size_t)(v)] | dir[3 * (size_t)(v) + 1] | dir[3 * (size_t)(v) + 2])
+    for (size_t i = 0; i < 4 * t->tet_count; i++)
+        if (ON_BOUNDARY(t->tets[i]))
+            start[t->tets[i] + 1]++;
     for (size_t v = 0; v < nv; v++)
         start[v + 1] += start[v];
-    uint32_t *inc = malloc((start[nv] ? start[nv] : 1) * sizeof *inc);
-    double *q0 = malloc((start[nv] ? start[nv] : 1) * sizeof *q0);
-    buckets g = {0};
-    pose_status s = inc && q0 ? buckets_build(surface, 0.5 * reach, &g) : POSE_ERR_OUT_OF_MEMORY;
-    if (s != POSE_OK) {
-        free(start);
-        free(inc);
-        free(q0);
-        free(g.start);
-        free(g.tri);
-        return s;
-    }
+    inc = malloc((start[nv] ? start[nv] : 1) * sizeof *inc);
+    q0 = malloc((start[nv] ? start[nv] : 1) * sizeof *q0);
+    if (!inc || !q0)
+        goto done;
+    s = buckets_build(surface, 0.5 * reach, &g);
+    if (s != POSE_OK)
+        goto done;
     size_t *fill = start; /* advanced while filling, shifted back below */
-    for (size_t i = 0; i < 4 * t->tet_count; i++) {
-        uint32_t v = t->tets[i];
-        if (dir[3 * (size_t)v] | dir[3 * (size_t)v + 1] | dir[3 * (size_t)v + 2])
-            inc[fill[v]++] = (uint32_t)(i / 4);
-    }
+    for (size_t i = 0; i < 4 * t->tet_count; i++)
+        if (ON_BOUNDARY(t->tets[i]))
+            inc[fill[t->tets[i]]++] = (uint32_t)(i / 4);
+#undef ON_BOUNDARY
     memmove(start + 1, start, nv * sizeof *start);
     start[0] = 0;
     for (size_t v = 0; v < nv; v++)
         for (size_t q = start[v]; q < start[v + 1]; q++)
             q0[q] = tet_shape(t->positions, t->tets + 4 * (size_t)inc[q], UINT32_MAX, NULL);
 
-    /* Targets from the staircase positions, then up to three sweeps: a move
-     * refused in one sweep (its neighbours not yet moved) often fits in the
-     * next. NaN marks a vertex that is done or has no target. */
-    float *target = malloc(3 * nv * sizeof *target);
-    if (!target) {
-        free(start);
-        free(inc);
-        free(q0);
-        free(g.start);
-        free(g.tri);
-        return POSE_ERR_OUT_OF_MEMORY;
-    }
+    /* Targets from the staircase positions (NaN: done or none), then sweeps:
+     * a move refused or cut short in one sweep often goes further in the
+     * next, once its neighbours have moved. */
     size_t pending = 0;
     for (size_t v = 0; v < nv; v++) {
-        const int8_t *dv = dir + 3 * v;
         double p[3] = {t->positions[3 * v], t->positions[3 * v + 1], t->positions[3 * v + 2]};
-        double tg[3] = {0, 0, 0};
-        if ((dv[0] | dv[1] | dv[2]) && snap_target(surface, &g, p, dv, reach, tg)) {
+        double tg[3];
+        target[3 * v] = NAN;
+        if (start[v + 1] > start[v] && snap_target(surface, &g, p, dir + 3 * v, reach, margin, tg)) {
             for (int k = 0; k < 3; k++)
                 target[3 * v + k] = (float)tg[k];
             pending++;
-        } else {
-            target[3 * v] = NAN;
         }
     }
-    for (int sweep = 0; sweep < 3 && pending; sweep++) {
+    for (int sweep = 0; sweep < PP_SNAP_SWEEPS && pending; sweep++)
         for (size_t v = 0; v < nv; v++) {
             if (isnan(target[3 * v]))
                 continue;
-            double p[3] = {t->positions[3 * v], t->positions[3 * v + 1], t->positions[3 * v + 2]};
-            for (int tries = 0; tries < 3; tries++) {
-                double f = tries == 0 ? 1.0 : tries == 1 ? 0.5 : 0.25;
-                double np[3];
-                for (int k = 0; k < 3; k++)
-                    np[k] = p[k] + f * ((double)target[3 * v + k] - p[k]);
-                int ok = 1;
-                for (size_t q = start[v]; q < start[v + 1] && ok; q++)
-                    ok = tet_shape(t->positions, t->tets + 4 * (size_t)inc[q], (uint32_t)v, np) >=
-                         fmin(PP_SNAP_MIN_SHAPE, q0[q]);
-                if (!ok)
-                    continue;
-                for (int k = 0; k < 3; k++)
-                    t->positions[3 * v + k] = (float)np[k];
-                if (tries == 0) {
-                    target[3 * v] = NAN;
-                    pending--;
-                    (*moved)++;
-                }
-                break;
+            double np[3] = {target[3 * v], target[3 * v + 1], target[3 * v + 2]};
+            if (try_move(t, (uint32_t)v, np, start, inc, q0) == 1.0) {
+                target[3 * v] = NAN;
+                pending--;
+                (*moved)++;
             }
         }
-    }
-    free(target);
-    free(start);
-    free(inc);
-    free(q0);
+done:
     free(g.start);
     free(g.tri);
-    return POSE_OK;
+    free(inc);
+    free(q0);
+    free(target);
+    free(start);
+    return s;
 }

@@ -138,7 +138,9 @@ pose_status run(const pp_voxels *vox, const pp_mesh *skin, const pp_tet_options 
     double ratio = opt->max_radius_edge > 0.0 ? opt->max_radius_edge : 1.414;
 
     pp_cells cells = {};
-    if (pp_cells_label(vox, c, &cells) != POSE_OK) {
+    if (pp_cells_label(vox, c, &cells) != POSE_OK ||
+        (skin && !opt->no_snap && pp_cells_dilate(&cells) != POSE_OK)) {
+        pp_cells_free(&cells);
         e->status = POSE_ERR_OUT_OF_MEMORY;
         snprintf(e->text, sizeof e->text, "tetrahedralize (tetgen): out of memory");
         return e->status;
@@ -243,7 +245,8 @@ pose_status run(const pp_voxels *vox, const pp_mesh *skin, const pp_tet_options 
                 for (int k = 0; k < 3; k++)
                     dir[3 * i + k] = (int8_t)(sum[3 * i + k] > 0 ? 1 : sum[3 * i + k] < 0 ? -1 : 0);
         size_t moved = 0;
-        pose_status s = pp_tet_snap(out, skin, dir.data(), (float)(2.0 * c), &moved);
+        pose_status s = pp_tet_snap(out, skin, dir.data(), (float)(PP_SNAP_REACH * c),
+                                    (float)(PP_SNAP_MARGIN * c), &moved);
         if (s != POSE_OK) {
             pp_tetmesh_free(out);
             e->status = s;

@@ -117,6 +117,21 @@ static pose_status label_bone(const pp_mesh *bone, uint16_t label, pp_voxels *v,
     return POSE_OK;
 }
 
+/* At least half of the bone's vertices within the box [lo, hi] grown by one
+ * voxel. */
+static int mostly_within(const pp_mesh *bone, const float lo[3], const float hi[3], float spacing)
+{
+    size_t in = 0;
+    for (size_t i = 0; i < bone->vertex_count; i++) {
+        const float *p = bone->positions + 3 * i;
+        int ok = 1;
+        for (int k = 0; k < 3; k++)
+            ok &= p[k] >= lo[k] - spacing && p[k] <= hi[k] + spacing;
+        in += (size_t)ok;
+    }
+    return 2 * in >= bone->vertex_count;
+}
+
 static pose_status fail(pp_voxels *out, char *err, size_t errlen, pose_status s, const char *msg)
 {
     pp_voxels_free(out);
@@ -215,6 +230,8 @@ pose_status pp_voxelize(const pp_mesh *skin, const pp_mesh *bones, const uint16_
     if (pp_mesh_topology_count(skin, &topo) == POSE_OK)
         r->skin_boundary_edges = topo.boundary_edges;
 
+    float skin_lo[3], skin_hi[3];
+    pp_mesh_bounds(skin, skin_lo, skin_hi);
     uint16_t max_label = 0;
     for (size_t b = 0; b < bone_count; b++) {
         if (pp_mesh_topology_count(&bones[b], &topo) == POSE_OK &&
@@ -227,8 +244,11 @@ pose_status pp_voxelize(const pp_mesh *skin, const pp_mesh *bones, const uint16_
             free(in_skin);
             return fail(out, err, errlen, s, "voxelize: out of memory");
         }
-        if (inside == 0) {
-            /* Not a bone poking out: a bone in another frame or unit. */
+        if (inside == 0 && !mostly_within(&bones[b], skin_lo, skin_hi, spacing)) {
+            /* Not a bone poking out, nor one in a part of the skin thinner
+             * than a voxel (a finger at 16 mm holds no voxel centre, but its
+             * bones lie within the skin's box): a bone in another frame or
+             * unit. */
             free(in_skin);
             snprintf(msg, sizeof msg,
                      "%s: the bone lies entirely outside the skin (check its units and frame)",

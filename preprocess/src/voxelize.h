@@ -17,7 +17,9 @@
  *  - bone voxels outside the skin become part of the body (bones poking out);
  *  - a voxel inside two bones keeps the first bone in input order;
  *  - a bone too thin to contain any voxel centre is marked by the voxels
- *    holding its vertices, so every joint keeps at least one bone voxel.
+ *    holding its vertices, so every joint keeps at least one bone voxel;
+ *    this holds also where the skin around it is too thin to hold a voxel
+ *    centre (fingers at coarse spacings): such voxels join the body.
  */
 #ifndef POSE_PP_VOXELIZE_H
 #define POSE_PP_VOXELIZE_H
@@ -71,8 +73,10 @@ typedef struct pp_voxel_report {
  * @param report      optional (NULL): counts and repairs
  * @return POSE_OK, POSE_ERR_INVALID_ARGUMENT (bad spacing, empty mesh,
  *         non-finite coordinate, grid too large; message names the mesh),
- *         POSE_ERR_INVALID_DATA (a bone with no voxel inside the skin: wrong
- *         units or frame; message names the bone), POSE_ERR_OUT_OF_MEMORY.
+ *         POSE_ERR_INVALID_DATA (a bone with no voxel inside the skin and
+ *         most of its vertices outside the skin's bounding box grown by one
+ *         voxel: wrong units or frame; message names the bone),
+ *         POSE_ERR_OUT_OF_MEMORY.
  */
 pose_status pp_voxelize(const pp_mesh *skin, const pp_mesh *bones, const uint16_t *bone_label,
                         size_t bone_count, float spacing, pp_voxels *out,

@@ -272,10 +272,12 @@ int pp_weights_compute(const pp_tetmesh *mesh, size_t joint_count, const pp_weig
         if (fixed[v] >= 0)
             topk_insert(out->weights + v * K, out->joints + v * K, K, 1.0, (unsigned)fixed[v]);
     if (nf > 0) {
-        if (pp_laplacian_assemble(mesh, free_index, nf, fixed, &lap, &cc) < 0) {
+        if (pp_laplacian_assemble(mesh, free_index, nf, fixed, !(opt && opt->plain_fem), &lap,
+                                  &cc) < 0) {
             rc = fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: out of memory assembling");
             goto done;
         }
+        rep.clipped_entries = lap.clipped;
         double t1 = now_s();
         rep.seconds_assemble = t1 - t0;
         cc.supernodal = CHOLMOD_AUTO;

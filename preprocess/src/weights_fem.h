@@ -28,6 +28,9 @@
 typedef struct pp_weight_options {
     unsigned influences; /**< K kept per vertex, 1..8; 0 = 4 */
     unsigned block;      /**< right-hand sides per solve; 0 = all joints at once */
+    int plain_fem;       /**< keep obtuse tets' positive Laplacian entries (the plain FEM
+                              operator: weights may leave [0, 1], then are clamped); 0 =
+                              lump them onto the diagonal (weights_matrix.h) */
 } pp_weight_options;
 
 typedef struct pp_weights {
@@ -50,6 +53,9 @@ typedef struct pp_weight_report {
     double max_weight;          /**< raw maximum (<= 1 + tiny) */
     double max_sum_error;       /**< max |Σ_j W_j - 1| over vertices (raw) */
     double max_dropped;         /**< largest weight removed by keeping K */
+    size_t clipped_entries;     /**< positive off-diagonal Laplacian entries (obtuse tets)
+                                     moved to the diagonal to keep the maximum principle
+                                     (weights_matrix.h) */
     double seconds_assemble, seconds_factor, seconds_solve;
 } pp_weight_report;
 

@@ -21,18 +21,23 @@ typedef struct pp_coupling {
 
 typedef struct pp_laplacian {
     cholmod_sparse *A;     /**< n_free x n_free, stype = 1 (upper part stored) */
-    pp_coupling *coupling;
+    pp_coupling *coupling; /**< one term per (row, joint), all <= 0 */
     size_t coupling_count;
+    size_t clipped;        /**< positive off-diagonal entries moved to the diagonal */
 } pp_laplacian;
 
 /**
- * Assemble with linear shape functions: A_ab = Σ_t V_t ∇φ_a·∇φ_b.
+ * Assemble with linear shape functions: A_ab = Σ_t V_t ∇φ_a·∇φ_b, then,
+ * with lump_obtuse, make it an M-matrix: each positive off-diagonal entry (an obtuse tet's
+ * edge) is moved onto the diagonal of its rows, keeping zero row sums, so
+ * the solution obeys the discrete maximum principle (weights in [0, 1]).
  * free_index[v] is the vertex's row among the free vertices, or -1 for a
  * fixed vertex whose joint is fixed_joint[v]. Degenerate tets contribute
  * nothing. Returns 0 on success, -1 when out of memory.
  */
 int pp_laplacian_assemble(const pp_tetmesh *m, const int32_t *free_index, size_t n_free,
-                          const int32_t *fixed_joint, pp_laplacian *out, cholmod_common *c);
+                          const int32_t *fixed_joint, int lump_obtuse, pp_laplacian *out,
+                          cholmod_common *c);
 void pp_laplacian_free(pp_laplacian *l, cholmod_common *c);
 
 /** Local stiffness of one tet: k[a][b] = V ∇φ_a·∇φ_b; returns V (0 if degenerate). */

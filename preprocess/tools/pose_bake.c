@@ -205,9 +205,11 @@ static void print_summary(const pp_bake_report *r, const pp_bake_options *o)
            w->free_vertices, w->fixed_vertices, w->supernodal ? "supernodal" : "simplicial",
            w->factor_nnz, w->max_sum_error, w->max_sum_error < 1e-6 ? "ok" : "FAILED",
            w->min_weight, w->max_weight);
+    if (w->clipped_entries) /* obtuse tets' positive entries, moved to the diagonal */
+        printf(" (%zu obtuse-edge entries lumped for the maximum principle)", w->clipped_entries);
     double over = fmax(-w->min_weight, w->max_weight - 1);
-    if (over > 1e-6) /* the discrete maximum principle needs non-obtuse tets */
-        printf(" (outside [0,1] by %.2g: obtuse tets; clamped)", over);
+    if (over > 1e-6)
+        printf(" (outside [0,1] by %.2g; clamped and renormalized)", over);
     printf("; largest weight dropped by K: %.3g\n", w->max_dropped);
     if (w->floating_regions || w->empty_joints || w->conflict_vertices)
         printf("weights: %zu soft islands pinned (%zu vertices), %zu joints without bone tets, "

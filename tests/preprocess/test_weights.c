@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "pp_test_mesh.h"
+#include "tetmesh.h"
 #include "weights_fem.h"
 
 enum { NX = 24, NY = 2, NZ = 2 };
@@ -188,6 +189,47 @@ static void test_floating_island_is_pinned(void **state)
     pp_tetmesh_free(&b);
 }
 
+/* A two-bone bar whose inner vertices are jittered by up to 0.25 cells, so
+ * that many tets are obtuse (as snapping makes them) and the plain FEM
+ * operator has positive off-diagonal entries (no maximum principle; on the
+ * shared body its weights reached -0.07..1.07). The default lumps those
+ * entries onto the diagonal, an M-matrix: the raw weights stay in [0, 1]
+ * before any clamping and still sum to 1. */
+static void test_obtuse_tets_keep_bounds(void **state)
+{
+    (void)state;
+    pp_tetmesh m;
+    assert_int_equal(pp_test_box(12, 4, 4, H, &m), 0);
+    pp_test_label_slab(&m, H, 0, 1, 1);
+    pp_test_label_slab(&m, H, 11, 12, 2);
+    uint32_t seed = 12345;
+    for (size_t v = 0; v < m.vertex_count; v++) {
+        float *p = m.positions + 3 * v;
+        if (p[0] < 1.5f * H || p[0] > 10.5f * H)
+            continue; /* bone vertices stay */
+        for (int k = 0; k < 3; k++) {
+            seed = seed * 1664525u + 1013904223u;
+            p[k] += 0.25f * H * ((float)(seed >> 8) / 16777216.0f * 2.0f - 1.0f);
+        }
+    }
+    for (size_t t = 0; t < m.tet_count; t++)
+        assert_true(pp_tet_volume(&m, t) > 0.0); /* still a valid mesh */
+    char err[256];
+    pp_weights w;
+    pp_weight_report plain, lumped;
+    pp_weight_options o = {.plain_fem = 1};
+    assert_int_equal(pp_weights_compute(&m, 2, &o, &w, &plain, err, sizeof err), POSE_OK);
+    pp_weights_free(&w);
+    assert_int_equal(plain.clipped_entries, 0);
+    assert_int_equal(pp_weights_compute(&m, 2, NULL, &w, &lumped, err, sizeof err), POSE_OK);
+    assert_true(lumped.clipped_entries > 0);
+    assert_true(lumped.min_weight >= -1e-9);
+    assert_true(lumped.max_weight <= 1 + 1e-9);
+    assert_true(lumped.max_sum_error < 1e-9);
+    pp_weights_free(&w);
+    pp_tetmesh_free(&m);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -196,6 +238,7 @@ int main(void)
         cmocka_unit_test(test_four_bone_bar),
         cmocka_unit_test(test_keep_k_largest),
         cmocka_unit_test(test_floating_island_is_pinned),
+        cmocka_unit_test(test_obtuse_tets_keep_bounds),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
