@@ -105,8 +105,12 @@ static void live_record(can_live *s, const pb_can_frame *f, int64_t real_ns)
     w.t_ns = real_ns;
     char line[PB_CANDUMP_LINE_MAX];
     int n = pb_candump_format(&w, s->iface[0] ? s->iface : "can0", line, sizeof line);
-    if (n > 0)
-        fwrite(line, 1, (size_t)n, s->record);
+    /* Flushed per frame so a crash loses at most the last one; on a write
+     * error (disk full) recording stops and the pose keeps running. */
+    if (n > 0 && (fwrite(line, 1, (size_t)n, s->record) != (size_t)n || fflush(s->record) != 0)) {
+        fclose(s->record);
+        s->record = NULL;
+    }
 }
 
 static int live_reopen(can_live *s)

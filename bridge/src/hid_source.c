@@ -166,7 +166,9 @@ static void record_report(hid_source *s, int64_t t_ns)
         return;
     if (s->record_t0 < 0)
         s->record_t0 = t_ns;
-    if (pb_hid_recorder_write_event(s->record, t_ns - s->record_t0, s->report, s->report_len) != 0)
+    /* Flushed per report so a crash loses at most the last one. */
+    if (pb_hid_recorder_write_event(s->record, t_ns - s->record_t0, s->report, s->report_len) != 0 ||
+        fflush(s->record) != 0)
         s->record = NULL; /* disk full or closed: stop recording, keep the pose running */
 }
 
