@@ -267,12 +267,14 @@ static int compare_backends(const char *data, const char *tmpl, double mm, int t
             rc = die(pp_tet_backend_name(backends[b]), err);
         } else {
             printf("  %-8s %6.1f s (tets %5.1f s, weights %5.1f s, cor %5.1f s), %zu vertices, %zu tets, "
-                   "dihedral %.1f..%.1f, weights %.3f..%.3f, skin outside %zu (max %.1f mm)\n",
+                   "dihedral %.1f..%.1f, weights %.3f..%.3f (%zu obtuse entries lumped), "
+                   "skin outside %zu (max %.1f mm)\n",
                    pp_tet_backend_name(backends[b]), r.total_seconds,
                    r.seconds[PP_STAGE_TETRAHEDRALIZE], r.seconds[PP_STAGE_WEIGHTS],
                    r.seconds[PP_STAGE_COR], r.quality.vertex_count, r.quality.tet_count,
                    r.quality.min_dihedral_deg, r.quality.max_dihedral_deg, r.weights.min_weight,
-                   r.weights.max_weight, r.tissues[0].outside, r.tissues[0].max_distance * 1e3);
+                   r.weights.max_weight, r.weights.clipped_entries, r.tissues[0].outside,
+                   r.tissues[0].max_distance * 1e3);
         }
         pp_bake_report_free(&r);
     }
