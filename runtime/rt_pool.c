@@ -2,7 +2,18 @@
 #include "rt_pool.h"
 
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdint.h>
+#include <time.h>
+
+/* How long a thread polls before it sleeps on a condition variable. A
+ * futex wake-up costs 10 us on bare metal and ~100 us where the idle core
+ * is a halted virtual CPU, more than a whole pass over a medium rig; polling
+ * a little longer than that keeps back-to-back passes (and frames) free of
+ * wake-ups, and an idle pool still ends up asleep. */
+#define SPIN_NS 200000L
+/* Polls between clock reads. */
+#define SPIN_CHECK 64
 
 struct pose__worker {
     pose__pool *pool;
@@ -12,13 +23,13 @@ struct pose__worker {
 
 struct pose__pool {
     pthread_mutex_t lock;
-    pthread_cond_t start;     /* signalled when a new task (generation) is posted */
-    pthread_cond_t done;      /* signalled when the last worker finishes */
+    pthread_cond_t start;         /* signalled when a new task (generation) is posted */
+    pthread_cond_t done;          /* signalled when the last worker finishes */
     unsigned threads;
-    unsigned pending;         /* workers still running the current task */
-    uint64_t generation;      /* task counter: a worker runs each generation once */
-    int stop;
-    pose__task_fn fn;
+    _Atomic unsigned pending;     /* workers still running the current task */
+    _Atomic uint64_t generation;  /* task counter: a worker runs each generation once */
+    _Atomic int stop;
+    pose__task_fn fn;             /* written before generation is bumped (release) */
     void *ctx;
     struct pose__worker workers[]; /* threads - 1 */
 };
@@ -28,36 +39,92 @@ size_t pose__pool_size(unsigned threads)
     return sizeof(pose__pool) + (threads > 1 ? threads - 1 : 0) * sizeof(struct pose__worker);
 }
 
+static inline void cpu_relax(void)
+{
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#elif defined(__aarch64__)
+    __asm__ volatile("yield");
+#endif
+}
+
+static long now_ns(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (long)t.tv_sec * 1000000000L + t.tv_nsec;
+}
+
+/* Poll until *gen differs from seen (1) or SPIN_NS pass (0). */
+static int spin_for_generation(pose__pool *p, uint64_t seen)
+{
+    long deadline = now_ns() + SPIN_NS;
+    for (;;) {
+        for (int i = 0; i < SPIN_CHECK; i++) {
+            if (atomic_load_explicit(&p->generation, memory_order_acquire) != seen)
+                return 1;
+            cpu_relax();
+        }
+        if (now_ns() > deadline)
+            return 0;
+    }
+}
+
+/* Poll until every worker is done (1) or SPIN_NS pass (0). */
+static int spin_for_done(pose__pool *p)
+{
+    long deadline = now_ns() + SPIN_NS;
+    for (;;) {
+        for (int i = 0; i < SPIN_CHECK; i++) {
+            if (atomic_load_explicit(&p->pending, memory_order_acquire) == 0)
+                return 1;
+            cpu_relax();
+        }
+        if (now_ns() > deadline)
+            return 0;
+    }
+}
+
 static void *worker_main(void *arg)
 {
     struct pose__worker *w = arg;
     pose__pool *p = w->pool;
     uint64_t seen = 0;
-    pthread_mutex_lock(&p->lock);
     for (;;) {
-        while (!p->stop && p->generation == seen)
-            pthread_cond_wait(&p->start, &p->lock);
-        if (p->stop)
+        if (!spin_for_generation(p, seen)) {
+            pthread_mutex_lock(&p->lock);
+            while (atomic_load_explicit(&p->generation, memory_order_acquire) == seen)
+                pthread_cond_wait(&p->start, &p->lock);
+            pthread_mutex_unlock(&p->lock);
+        }
+        if (atomic_load_explicit(&p->stop, memory_order_acquire))
             break;
-        seen = p->generation;
-        pose__task_fn fn = p->fn;
-        void *ctx = p->ctx;
-        pthread_mutex_unlock(&p->lock);
-        fn(ctx, w->part, p->threads);
-        pthread_mutex_lock(&p->lock);
-        if (--p->pending == 0)
+        seen = atomic_load_explicit(&p->generation, memory_order_acquire);
+        p->fn(p->ctx, w->part, p->threads);
+        if (atomic_fetch_sub_explicit(&p->pending, 1, memory_order_acq_rel) == 1) {
+            /* under the lock: the caller may be between its check and its wait */
+            pthread_mutex_lock(&p->lock);
             pthread_cond_signal(&p->done);
+            pthread_mutex_unlock(&p->lock);
+        }
     }
-    pthread_mutex_unlock(&p->lock);
     return NULL;
+}
+
+/* Bump the generation under the lock (sleeping workers re-check it there)
+ * and wake the sleepers; polling workers see it directly. */
+static void post(pose__pool *p)
+{
+    pthread_mutex_lock(&p->lock);
+    atomic_fetch_add_explicit(&p->generation, 1, memory_order_release);
+    pthread_cond_broadcast(&p->start);
+    pthread_mutex_unlock(&p->lock);
 }
 
 static void stop_workers(pose__pool *p, unsigned started)
 {
-    pthread_mutex_lock(&p->lock);
-    p->stop = 1;
-    pthread_cond_broadcast(&p->start);
-    pthread_mutex_unlock(&p->lock);
+    atomic_store_explicit(&p->stop, 1, memory_order_release);
+    post(p);
     for (unsigned i = 0; i < started; i++)
         pthread_join(p->workers[i].thread, NULL);
     pthread_cond_destroy(&p->done);
@@ -70,9 +137,9 @@ int pose__pool_init(pose__pool *p, unsigned threads)
     if (threads < 1)
         threads = 1;
     p->threads = threads;
-    p->pending = 0;
-    p->generation = 0;
-    p->stop = 0;
+    atomic_init(&p->pending, 0);
+    atomic_init(&p->generation, 0);
+    atomic_init(&p->stop, 0);
     p->fn = NULL;
     p->ctx = NULL;
     if (pthread_mutex_init(&p->lock, NULL) != 0)
@@ -114,16 +181,16 @@ void pose__pool_run(pose__pool *p, pose__task_fn fn, void *ctx)
         fn(ctx, 0, 1);
         return;
     }
-    pthread_mutex_lock(&p->lock);
+    /* no worker reads these until it sees the new generation */
     p->fn = fn;
     p->ctx = ctx;
-    p->pending = p->threads - 1;
-    p->generation++;
-    pthread_cond_broadcast(&p->start);
-    pthread_mutex_unlock(&p->lock);
+    atomic_store_explicit(&p->pending, p->threads - 1, memory_order_relaxed);
+    post(p);
     fn(ctx, 0, p->threads);
+    if (spin_for_done(p))
+        return;
     pthread_mutex_lock(&p->lock);
-    while (p->pending > 0)
+    while (atomic_load_explicit(&p->pending, memory_order_acquire) > 0)
         pthread_cond_wait(&p->done, &p->lock);
     pthread_mutex_unlock(&p->lock);
 }
