@@ -66,6 +66,7 @@ char *pp_bake_report_json(const pp_bake_report *r, const pp_bake_options *o)
     cJSON_AddNumberToObject(vx, "body", (double)r->voxels.body_voxels);
     cJSON_AddNumberToObject(vx, "bone", (double)r->voxels.bone_voxels);
     cJSON_AddNumberToObject(vx, "skin_boundary_edges", (double)r->voxels.skin_boundary_edges);
+    cJSON_AddNumberToObject(vx, "skin_volume_m3", r->voxels.skin_volume);
     cJSON_AddNumberToObject(vx, "open_bone_meshes", (double)r->voxels.open_bone_meshes);
     cJSON_AddNumberToObject(vx, "bone_voxels_outside_skin", (double)r->voxels.bone_voxels_outside_skin);
     cJSON_AddNumberToObject(vx, "overlap_voxels", (double)r->voxels.overlap_voxels);
@@ -80,6 +81,8 @@ char *pp_bake_report_json(const pp_bake_report *r, const pp_bake_options *o)
     cJSON_AddNumberToObject(tq, "max_dihedral_deg", r->quality.max_dihedral_deg);
     cJSON_AddNumberToObject(tq, "max_radius_edge", r->quality.max_radius_edge);
     cJSON_AddNumberToObject(tq, "inverted", (double)r->quality.inverted_count);
+    /* against voxels.skin_volume_m3: the mesh encloses the skin (tetmesh.h) */
+    cJSON_AddNumberToObject(tq, "volume_m3", r->quality.total_volume);
 
     cJSON *w = cJSON_AddObjectToObject(root, "weights");
     cJSON_AddNumberToObject(w, "free_vertices", (double)r->weights.free_vertices);
