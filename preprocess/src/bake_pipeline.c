@@ -24,27 +24,6 @@ const char *pp_bake_stage_name(pp_bake_stage s)
     return (unsigned)s < PP_STAGE_COUNT ? names[s] : "?";
 }
 
-#if defined(__GNUC__)
-__attribute__((format(printf, 4, 5)))
-#endif
-static int fail(char *err, size_t n, int status, const char *fmt, ...)
-{
-    if (err && n) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, n, fmt, ap);
-        va_end(ap);
-    }
-    return status;
-}
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 typedef struct stage_clock {
     const pp_bake_options *opt;
     pp_bake_report *rep;
@@ -63,14 +42,14 @@ static double share_before(pp_bake_stage s)
 static void stage_begin(stage_clock *c, pp_bake_stage s)
 {
     c->stage = s;
-    c->start = now_s();
+    c->start = pp_now_s();
     if (c->opt->progress)
         c->opt->progress(s, 0, share_before(s), c->opt->user);
 }
 
 static void stage_end(stage_clock *c)
 {
-    c->rep->seconds[c->stage] = now_s() - c->start;
+    c->rep->seconds[c->stage] = pp_now_s() - c->start;
     if (c->opt->progress)
         c->opt->progress(c->stage, 1, share_before(c->stage) + stage_share[c->stage], c->opt->user);
 }
@@ -148,7 +127,7 @@ static int load_meshes(const pp_bake_options *o, bake_state *s, pp_bake_report *
     s->bone_joint = calloc(o->bone_count ? o->bone_count : 1, sizeof *s->bone_joint);
     s->organs = calloc(o->organ_count ? o->organ_count : 1, sizeof *s->organs);
     if (!s->bones || !s->bone_joint || !s->organs)
-        return fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+        return pp_fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
     float slo[3], shi[3];
     pp_mesh_bounds(&s->skin, slo, shi);
     for (size_t i = 0; i < o->bone_count; i++) {
@@ -157,14 +136,14 @@ static int load_meshes(const pp_bake_options *o, bake_state *s, pp_bake_report *
             return rc;
         for (size_t k = 0; k < i; k++)
             if (strcmp(s->bones[k].name, s->bones[i].name) == 0)
-                return fail(err, n, POSE_ERR_INVALID_ARGUMENT,
+                return pp_fail(err, n, POSE_ERR_INVALID_ARGUMENT,
                             "%s: a bone named '%s' was already given (%s); bone names are file "
                             "stems and must be unique",
                             o->bone_paths[i], s->bones[i].name, o->bone_paths[k]);
         float lo[3], hi[3];
         pp_mesh_bounds(&s->bones[i], lo, hi);
         if (!overlaps(lo, hi, slo, shi))
-            return fail(err, n, POSE_ERR_INVALID_DATA,
+            return pp_fail(err, n, POSE_ERR_INVALID_DATA,
                         "%s: bone '%s' lies entirely outside the skin %s (are both in the same "
                         "frame and units?)",
                         o->bone_paths[i], s->bones[i].name, o->skin_path);
@@ -188,14 +167,14 @@ static int build_tissues(const pp_bake_options *o, bake_state *s, pp_bake_report
     s->emb_bary = calloc(nt, sizeof *s->emb_bary);
     s->tissues = calloc(nt, sizeof *s->tissues);
     if (!rep->tissues || !s->emb_tet || !s->emb_bary || !s->tissues)
-        return fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+        return pp_fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
     rep->tissue_count = nt;
     /* Bones embed in tets that move rigidly with their joint: labelled with
      * it and with weight exactly 1 at all four corners. A bone tet touching
      * another bone (a shared, reassigned corner) would bend the bone. */
     s->rigid_labels = malloc((s->tet.tet_count ? s->tet.tet_count : 1) * sizeof *s->rigid_labels);
     if (!s->rigid_labels)
-        return fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+        return pp_fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
     for (size_t t = 0; t < s->tet.tet_count; t++) {
         uint16_t lab = s->tet.labels[t];
         for (int c = 0; lab && c < 4; c++)
@@ -208,7 +187,7 @@ static int build_tissues(const pp_bake_options *o, bake_state *s, pp_bake_report
     char herr[256];
     int rc = pp_tet_hash_build(&s->rigid, 0, &s->hash, herr, sizeof herr);
     if (rc < 0)
-        return fail(err, n, rc, "%s", herr);
+        return pp_fail(err, n, rc, "%s", herr);
     int threads = o->threads > 0 ? o->threads : 1;
     for (size_t t = 0; t < nt; t++) {
         const pp_mesh *m;
@@ -223,7 +202,7 @@ static int build_tissues(const pp_bake_options *o, bake_state *s, pp_bake_report
         }
         for (size_t k = 0; k < t; k++)
             if (strcmp(rep->tissues[k].name, m->name) == 0)
-                return fail(err, n, POSE_ERR_INVALID_ARGUMENT,
+                return pp_fail(err, n, POSE_ERR_INVALID_ARGUMENT,
                             "two tissues are named '%s' (names are file stems; rename one file)",
                             m->name);
         pp_bake_tissue *bt = &rep->tissues[t];
@@ -233,14 +212,14 @@ static int build_tissues(const pp_bake_options *o, bake_state *s, pp_bake_report
         s->emb_tet[t] = malloc((m->vertex_count ? m->vertex_count : 1) * sizeof(uint32_t));
         s->emb_bary[t] = malloc((m->vertex_count ? m->vertex_count : 1) * 4 * sizeof(float));
         if (!s->emb_tet[t] || !s->emb_bary[t])
-            return fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+            return pp_fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
         pp_embed_report er = {0};
         /* A bone follows its own bone's tets when they are within two voxels. */
         double reach = 2.0 * rep->voxel_mm * 1e-3;
         rc = pp_embed_points(s->hash, m->positions, m->vertex_count, joint >= 0 ? joint + 1 : -1,
                              reach, threads, s->emb_tet[t], s->emb_bary[t], &er);
         if (rc < 0)
-            return fail(err, n, rc, "mapping '%s' failed", m->name);
+            return pp_fail(err, n, rc, "mapping '%s' failed", m->name);
         bt->vertices = er.vertices;
         bt->outside = er.outside;
         bt->max_distance = er.max_distance;
@@ -263,7 +242,7 @@ static int write_rig(const pp_bake_options *o, bake_state *s, pp_bake_report *re
     const pp_template *t = &rep->tmpl;
     s->joints = calloc(t->joint_count, sizeof *s->joints);
     if (!s->joints)
-        return fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+        return pp_fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
     for (size_t j = 0; j < t->joint_count; j++) {
         const pp_template_joint *tj = &t->joints[j];
         pose_joint_desc *d = &s->joints[j];
@@ -293,18 +272,18 @@ static int write_rig(const pp_bake_options *o, bake_state *s, pp_bake_report *re
     size_t len = strlen(o->output_path) + 32;
     char *tmp = malloc(len);
     if (!tmp)
-        return fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+        return pp_fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
     snprintf(tmp, len, "%s.tmp%ld", o->output_path, (long)getpid());
     pose_status st = pose_rig_write_file(&desc, tmp);
     if (st != POSE_OK) {
-        int rc = fail(err, n, st, "%s: writing the rig failed: %s", o->output_path,
+        int rc = pp_fail(err, n, st, "%s: writing the rig failed: %s", o->output_path,
                       pose_last_error());
         unlink(tmp);
         free(tmp);
         return rc;
     }
     if (rename(tmp, o->output_path) != 0) {
-        int rc = fail(err, n, POSE_ERR_IO, "%s: cannot move the finished rig into place: %s",
+        int rc = pp_fail(err, n, POSE_ERR_IO, "%s: cannot move the finished rig into place: %s",
                       o->output_path, strerror(errno));
         unlink(tmp);
         free(tmp);
@@ -325,16 +304,16 @@ int pp_bake(const pp_bake_options *o, pp_bake_report *rep, char *err, size_t n)
 {
     memset(rep, 0, sizeof *rep);
     if (!o || !o->skin_path || !o->template_path || !o->output_path || (o->bone_count && !o->bone_paths))
-        return fail(err, n, POSE_ERR_INVALID_ARGUMENT,
+        return pp_fail(err, n, POSE_ERR_INVALID_ARGUMENT,
                     "bake: skin, template and output are required");
     if (o->bone_count == 0)
-        return fail(err, n, POSE_ERR_INVALID_ARGUMENT, "bake: no bone meshes given");
+        return pp_fail(err, n, POSE_ERR_INVALID_ARGUMENT, "bake: no bone meshes given");
     if (!pp_tet_backend_available(o->backend))
-        return fail(err, n, POSE_ERR_UNSUPPORTED,
+        return pp_fail(err, n, POSE_ERR_UNSUPPORTED,
                     "bake: the %s backend is not built in (configure with POSE_WITH_TETGEN=ON "
                     "and libtet1.5-dev)",
                     pp_tet_backend_name(o->backend));
-    double t0 = now_s();
+    double t0 = pp_now_s();
     bake_state s;
     memset(&s, 0, sizeof s);
     stage_clock clk = {o, rep, PP_STAGE_LOAD, 0};
@@ -350,7 +329,7 @@ int pp_bake(const pp_bake_options *o, pp_bake_report *rep, char *err, size_t n)
     stage_begin(&clk, PP_STAGE_RIG);
     rep->fits = calloc(rep->tmpl.joint_count, sizeof *rep->fits);
     if (!rep->fits) {
-        rc = fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+        rc = pp_fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
         goto done;
     }
     rc = pp_rig_fit(&rep->tmpl, s.bones, o->bone_count, rep->fits, err, n);
@@ -362,7 +341,7 @@ int pp_bake(const pp_bake_options *o, pp_bake_report *rep, char *err, size_t n)
     s.rig_bones = calloc(o->bone_count, sizeof *s.rig_bones);
     s.rig_labels = calloc(o->bone_count, sizeof *s.rig_labels);
     if (!s.rig_bones || !s.rig_labels) {
-        rc = fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+        rc = pp_fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
         goto done;
     }
     for (size_t i = 0; i < o->bone_count; i++)
@@ -403,7 +382,7 @@ int pp_bake(const pp_bake_options *o, pp_bake_report *rep, char *err, size_t n)
     if (!o->no_cor) {
         s.cor = malloc(3 * s.tet.vertex_count * sizeof *s.cor);
         if (!s.cor) {
-            rc = fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory for CoR");
+            rc = pp_fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory for CoR");
             goto done;
         }
         pp_cor_options co = {.threads = threads, .tolerance = o->cor_step};
@@ -423,7 +402,7 @@ int pp_bake(const pp_bake_options *o, pp_bake_report *rep, char *err, size_t n)
     rc = POSE_OK;
 done:
     bake_state_free(&s, o, rep->tissue_count);
-    rep->total_seconds = now_s() - t0;
+    rep->total_seconds = pp_now_s() - t0;
     struct rusage ru;
     if (getrusage(RUSAGE_SELF, &ru) == 0)
         rep->peak_rss_mb = (double)ru.ru_maxrss / 1024.0;

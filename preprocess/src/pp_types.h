@@ -48,6 +48,16 @@ typedef struct pp_tet_quality {
     double seconds;            /**< wall time of the stage that built the mesh */
 } pp_tet_quality;
 
+/** Seconds on CLOCK_MONOTONIC, for stage timings. */
+double pp_now_s(void);
+
+/** Write a printf-style message into err[n] (when err is not NULL) and return status. */
+int pp_fail(char *err, size_t n, int status, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+
 void pp_mesh_free(pp_mesh *m);
 void pp_voxels_free(pp_voxels *v);
 void pp_tetmesh_free(pp_tetmesh *t);

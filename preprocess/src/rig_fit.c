@@ -197,20 +197,6 @@ static int contact_points(const pp_mesh **from, size_t nfrom, const pp_mesh **to
     return 1;
 }
 
-#if defined(__GNUC__)
-__attribute__((format(printf, 4, 5)))
-#endif
-static int fail(char *err, size_t n, int status, const char *fmt, ...)
-{
-    if (err && n) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, n, fmt, ap);
-        va_end(ap);
-    }
-    return status;
-}
-
 static const pp_mesh *find_bone(const pp_mesh *bones, size_t n, const char *name)
 {
     for (size_t i = 0; i < n; i++)
@@ -232,7 +218,7 @@ static int resolve(const pp_template_joint *j, char (*names)[PP_NAME_MAX], size_
     for (size_t i = 0; i < count; i++) {
         const pp_mesh *m = find_bone(bones, nb, names[i]);
         if (!m)
-            return fail(err, err_size, POSE_ERR_NOT_FOUND,
+            return pp_fail(err, err_size, POSE_ERR_NOT_FOUND,
                         "joint '%s': bone mesh '%s' named by the template was not given", j->name,
                         names[i]);
         out[(*nout)++] = m;
@@ -292,7 +278,7 @@ static int fit_centre(const pp_template *t, size_t ji, const pp_mesh *bones, siz
     for (int k = 0; k < 3; k++)
         axis_out[k] = j->axis[k];
     if (!child || !parent) {
-        rc = fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+        rc = pp_fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "out of memory");
         goto done;
     }
     /* Every bone of the segment must exist, contact or not. */
@@ -307,7 +293,7 @@ static int fit_centre(const pp_template *t, size_t ji, const pp_mesh *bones, siz
                 for (int k = 0; k < 3; k++)
                     sum[k] += child[b]->positions[3 * v + k];
         if (n == 0) {
-            rc = fail(err, err_size, POSE_ERR_INVALID_DATA, "joint '%s': its bones have no vertices",
+            rc = pp_fail(err, err_size, POSE_ERR_INVALID_DATA, "joint '%s': its bones have no vertices",
                       j->name);
             goto done;
         }
@@ -330,13 +316,13 @@ static int fit_centre(const pp_template *t, size_t ji, const pp_mesh *bones, siz
     if (r1 >= 0 && (both || j->side == PP_SIDE_PARENT))
         r2 = contact_points(parent, np, child, nc, d, &pts);
     if (r1 < 0 || r2 < 0) {
-        rc = fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+        rc = pp_fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "out of memory");
         goto done;
     }
     o->contact_points = pts.n;
     size_t need = j->rule == PP_FIT_SPINE ? 1 : 8;
     if (pts.n < need) {
-        rc = fail(err, err_size, POSE_ERR_INVALID_DATA,
+        rc = pp_fail(err, err_size, POSE_ERR_INVALID_DATA,
                   "joint '%s': no contact region: %zu vertices of its bones lie within %.1f mm of "
                   "parent '%s' (need %zu); the bones are too far apart or 'contact_mm' is too small",
                   j->name, pts.n, (double)j->contact_mm, pj->name, need);
@@ -361,7 +347,7 @@ static int fit_centre(const pp_template *t, size_t ji, const pp_mesh *bones, siz
                     for (int k = 0; k < 3; k++)
                         dd += (x[k] - mean[k]) * (x[k] - mean[k]);
                     if (dd <= g2 && !pts_push(&pts, x)) {
-                        rc = fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+                        rc = pp_fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "out of memory");
                         goto done;
                     }
                 }
@@ -401,7 +387,7 @@ static int fit_centre(const pp_template *t, size_t ji, const pp_mesh *bones, siz
             ok = 0;
     }
     if (!ok) {
-        rc = fail(err, err_size, POSE_ERR_INVALID_DATA,
+        rc = pp_fail(err, err_size, POSE_ERR_INVALID_DATA,
                   "joint '%s': the %s fit of its %zu contact points degenerates (flat or "
                   "collinear region); try 'fit': \"parent\" or \"both\", or a larger 'contact_mm'",
                   j->name, pp_fit_rule_name(j->rule), pts.n);
@@ -506,11 +492,11 @@ int pp_rig_fit(const pp_template *t, const pp_mesh *bones, size_t bone_count, pp
                char *err, size_t err_size)
 {
     if (!t || !out || (bone_count && !bones))
-        return fail(err, err_size, POSE_ERR_INVALID_ARGUMENT, "rig fit: NULL argument");
+        return pp_fail(err, err_size, POSE_ERR_INVALID_ARGUMENT, "rig fit: NULL argument");
     memset(out, 0, t->joint_count * sizeof *out);
     double(*axes)[3] = calloc(t->joint_count ? t->joint_count : 1, sizeof *axes);
     if (!axes)
-        return fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+        return pp_fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "out of memory");
     int rc = POSE_OK;
     for (size_t i = 0; i < t->joint_count && rc >= 0; i++)
         rc = fit_centre(t, i, bones, bone_count, &out[i], axes[i], err, err_size);

@@ -55,13 +55,6 @@ int pp_tet_backend_available(pp_tet_backend b)
     return 0;
 }
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* Bone labels present in the image but on no tet. */
 static size_t lost_labels(const pp_voxels *vox, const pp_tetmesh *t)
 {
@@ -107,12 +100,12 @@ pose_status pp_tetrahedralize(const pp_voxels *vox, const pp_mesh *skin,
                      pp_tet_backend_name(b));
         return POSE_ERR_UNSUPPORTED;
     }
-    double t0 = now_s();
+    double t0 = pp_now_s();
     pose_status s = b == PP_TET_TETGEN ? pp_tet_tetgen(vox, skin, opt, out, err, errlen)
                                        : pp_tet_lattice(vox, skin, opt, out, err, errlen);
     if (s != POSE_OK)
         return s;
-    double secs = now_s() - t0;
+    double secs = pp_now_s() - t0;
     pp_tet_quality local;
     pp_tet_quality *qq = q ? q : &local;
     pp_tet_quality_measure(out, qq);

@@ -12,13 +12,6 @@
 #include <string.h>
 #include <time.h>
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static void voxel_of(const pp_voxels *v, const float p[3], int idx[3])
 {
     for (int k = 0; k < 3; k++)
@@ -144,7 +137,7 @@ pose_status pp_voxelize(const pp_mesh *skin, const pp_mesh *bones, const uint16_
                         size_t bone_count, float spacing, pp_voxels *out,
                         pp_voxel_report *report, char *err, size_t errlen)
 {
-    double t0 = now_s();
+    double t0 = pp_now_s();
     pp_voxel_report local;
     pp_voxel_report *r = report ? report : &local;
     memset(r, 0, sizeof *r);
@@ -287,6 +280,6 @@ pose_status pp_voxelize(const pp_mesh *skin, const pp_mesh *bones, const uint16_
     r->total_voxels = count;
     r->body_volume = (double)r->body_voxels * cell;
     r->skin_volume = (double)skin_count * cell;
-    r->seconds = now_s() - t0;
+    r->seconds = pp_now_s() - t0;
     return POSE_OK;
 }

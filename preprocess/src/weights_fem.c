@@ -11,27 +11,6 @@
 #include <string.h>
 #include <time.h>
 
-#if defined(__GNUC__)
-__attribute__((format(printf, 4, 5)))
-#endif
-static int fail(char *err, size_t n, int status, const char *fmt, ...)
-{
-    if (err && n) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, n, fmt, ap);
-        va_end(ap);
-    }
-    return status;
-}
-
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* Fixed joint per vertex from the bone tets: -1 free, else the joint. A
  * vertex in tets of two bones takes the one with more incident tets. */
 static int fixed_joints(const pp_tetmesh *m, size_t joint_count, int32_t *fixed, size_t *conflicts,
@@ -42,7 +21,7 @@ static int fixed_joints(const pp_tetmesh *m, size_t joint_count, int32_t *fixed,
         fixed[v] = -1;
     uint8_t *seen = calloc(joint_count ? joint_count : 1, 1);
     if (!seen)
-        return fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: out of memory");
+        return pp_fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: out of memory");
     size_t nconf = 0;
     for (size_t t = 0; t < m->tet_count; t++) {
         unsigned lab = m->labels[t];
@@ -50,7 +29,7 @@ static int fixed_joints(const pp_tetmesh *m, size_t joint_count, int32_t *fixed,
             continue;
         if (lab > joint_count) {
             free(seen);
-            return fail(err, err_size, POSE_ERR_INVALID_DATA,
+            return pp_fail(err, err_size, POSE_ERR_INVALID_DATA,
                         "weights: tet %zu has label %u but there are %zu joints", t, lab, joint_count);
         }
         seen[lab - 1] = 1;
@@ -69,7 +48,7 @@ static int fixed_joints(const pp_tetmesh *m, size_t joint_count, int32_t *fixed,
         empty += !seen[j];
     free(seen);
     if (empty == joint_count)
-        return fail(err, err_size, POSE_ERR_INVALID_DATA,
+        return pp_fail(err, err_size, POSE_ERR_INVALID_DATA,
                     "weights: no tet is labelled as bone; nothing to bind the skin to");
     *empty_joints = empty;
     *conflicts = 0;
@@ -79,13 +58,13 @@ static int fixed_joints(const pp_tetmesh *m, size_t joint_count, int32_t *fixed,
     int32_t *slot = malloc(n * sizeof *slot);
     size_t nc = 0;
     if (!slot)
-        return fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: out of memory");
+        return pp_fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: out of memory");
     for (size_t v = 0; v < n; v++)
         slot[v] = fixed[v] == -2 ? (int32_t)nc++ : -1;
     uint32_t *votes = calloc(nc * joint_count, sizeof *votes);
     if (!votes) {
         free(slot);
-        return fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: out of memory");
+        return pp_fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: out of memory");
     }
     for (size_t t = 0; t < m->tet_count; t++)
         if (m->labels[t])
@@ -224,16 +203,16 @@ int pp_weights_compute(const pp_tetmesh *mesh, size_t joint_count, const pp_weig
     memset(out, 0, sizeof *out);
     unsigned K = opt && opt->influences ? opt->influences : 4;
     if (K > PP_MAX_INFLUENCES)
-        return fail(err, err_size, POSE_ERR_INVALID_ARGUMENT, "weights: K = %u; at most %d", K,
+        return pp_fail(err, err_size, POSE_ERR_INVALID_ARGUMENT, "weights: K = %u; at most %d", K,
                     PP_MAX_INFLUENCES);
     if (joint_count == 0 || joint_count > UINT16_MAX)
-        return fail(err, err_size, POSE_ERR_INVALID_ARGUMENT, "weights: %zu joints", joint_count);
+        return pp_fail(err, err_size, POSE_ERR_INVALID_ARGUMENT, "weights: %zu joints", joint_count);
     if (K > joint_count)
         K = (unsigned)joint_count;
     size_t n = mesh->vertex_count;
     if (n == 0 || mesh->tet_count == 0 || n > INT32_MAX)
-        return fail(err, err_size, POSE_ERR_INVALID_DATA, "weights: the tet mesh is empty");
-    double t0 = now_s();
+        return pp_fail(err, err_size, POSE_ERR_INVALID_DATA, "weights: the tet mesh is empty");
+    double t0 = pp_now_s();
     int32_t *fixed = malloc(n * sizeof *fixed), *free_index = malloc(n * sizeof *free_index);
     int rc = POSE_OK;
     cholmod_common cc;
@@ -247,7 +226,7 @@ int pp_weights_compute(const pp_tetmesh *mesh, size_t joint_count, const pp_weig
     out->joints = calloc(n * K, sizeof *out->joints);
     out->weights = malloc(n * K * sizeof *out->weights);
     if (!fixed || !free_index || !out->joints || !out->weights) {
-        rc = fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: out of memory");
+        rc = pp_fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: out of memory");
         goto done;
     }
     rc = fixed_joints(mesh, joint_count, fixed, &rep.conflict_vertices, &rep.empty_joints, err,
@@ -255,7 +234,7 @@ int pp_weights_compute(const pp_tetmesh *mesh, size_t joint_count, const pp_weig
     if (rc < 0)
         goto done;
     if (pin_floating(mesh, fixed, &rep.floating_regions, &rep.floating_vertices) < 0) {
-        rc = fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: out of memory");
+        rc = pp_fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: out of memory");
         goto done;
     }
     size_t nf = 0;
@@ -274,18 +253,18 @@ int pp_weights_compute(const pp_tetmesh *mesh, size_t joint_count, const pp_weig
     if (nf > 0) {
         if (pp_laplacian_assemble(mesh, free_index, nf, fixed, !(opt && opt->plain_fem), &lap,
                                   &cc) < 0) {
-            rc = fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: out of memory assembling");
+            rc = pp_fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: out of memory assembling");
             goto done;
         }
         rep.clipped_entries = lap.clipped;
-        double t1 = now_s();
+        double t1 = pp_now_s();
         rep.seconds_assemble = t1 - t0;
         cc.supernodal = CHOLMOD_AUTO;
         L = cholmod_analyze(lap.A, &cc);
         if (L)
             cholmod_factorize(lap.A, L, &cc);
         if (!L || cc.status != CHOLMOD_OK || L->minor < L->n) {
-            rc = fail(err, err_size, POSE_ERR_INVALID_DATA,
+            rc = pp_fail(err, err_size, POSE_ERR_INVALID_DATA,
                       "weights: Cholesky factorization failed (CHOLMOD status %d, minor %zu of %zu): "
                       "the mesh has degenerate tets",
                       cc.status, L ? (size_t)L->minor : 0, nf);
@@ -293,7 +272,7 @@ int pp_weights_compute(const pp_tetmesh *mesh, size_t joint_count, const pp_weig
         }
         rep.supernodal = L->is_super;
         rep.factor_nnz = (size_t)cc.lnz;
-        double t2 = now_s();
+        double t2 = pp_now_s();
         rep.seconds_factor = t2 - t1;
         unsigned block = opt && opt->block ? opt->block : (unsigned)joint_count;
         if (block > joint_count)
@@ -301,13 +280,13 @@ int pp_weights_compute(const pp_tetmesh *mesh, size_t joint_count, const pp_weig
         sum = calloc(nf, sizeof *sum);
         B = cholmod_allocate_dense(nf, block, nf, CHOLMOD_REAL, &cc);
         if (!sum || !B) {
-            rc = fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: out of memory for %u "
+            rc = pp_fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: out of memory for %u "
                       "right-hand sides", block);
             goto done;
         }
         size_t *free_vertex = malloc(nf * sizeof *free_vertex);
         if (!free_vertex) {
-            rc = fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: out of memory");
+            rc = pp_fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: out of memory");
             goto done;
         }
         for (size_t v = 0; v < n; v++)
@@ -326,7 +305,7 @@ int pp_weights_compute(const pp_tetmesh *mesh, size_t joint_count, const pp_weig
             cholmod_dense *X = cholmod_solve(CHOLMOD_A, L, B, &cc);
             if (!X) {
                 free(free_vertex);
-                rc = fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: CHOLMOD solve failed");
+                rc = pp_fail(err, err_size, POSE_ERR_OUT_OF_MEMORY, "weights: CHOLMOD solve failed");
                 goto done;
             }
             const double *x = X->x;
@@ -347,7 +326,7 @@ int pp_weights_compute(const pp_tetmesh *mesh, size_t joint_count, const pp_weig
         for (size_t f = 0; f < nf; f++)
             rep.max_sum_error = fmax(rep.max_sum_error, fabs(sum[f] - 1.0));
         free(free_vertex);
-        rep.seconds_solve = now_s() - t2;
+        rep.seconds_solve = pp_now_s() - t2;
     }
     /* Clamp round-off negatives, renormalize the K kept, pad unused slots. */
     for (size_t v = 0; v < n; v++) {
