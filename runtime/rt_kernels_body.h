@@ -38,19 +38,18 @@ static POSE__INLINE void store_lanes(float *restrict out, size_t b, size_t count
     float *o = out + 3 * POSE__BLOCK * b;
 #ifdef __AVX2__
     if (n >= 8 && ((uintptr_t)o & 31u) == 0) {
+        /* 8x3 transpose: six in-lane shuffles give each 128-bit half its
+         * own x y z x / y z x y / z x y z groups, three lane swaps join them */
         const __m256 x = (__m256)*px, y = (__m256)*py, z = (__m256)*pz;
-        const __m256i i0 = _mm256_setr_epi32(0, 0, 0, 1, 1, 1, 2, 2);
-        const __m256i i1 = _mm256_setr_epi32(2, 3, 3, 3, 4, 4, 4, 5);
-        const __m256i i2 = _mm256_setr_epi32(5, 5, 6, 6, 6, 7, 7, 7);
-        __m256 a = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(x, i0),
-                                                   _mm256_permutevar8x32_ps(y, i0), 0x92),
-                                   _mm256_permutevar8x32_ps(z, i0), 0x24);
-        __m256 c = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(x, i1),
-                                                   _mm256_permutevar8x32_ps(y, i1), 0x24),
-                                   _mm256_permutevar8x32_ps(z, i1), 0x49);
-        __m256 e = _mm256_blend_ps(_mm256_blend_ps(_mm256_permutevar8x32_ps(x, i2),
-                                                   _mm256_permutevar8x32_ps(y, i2), 0x49),
-                                   _mm256_permutevar8x32_ps(z, i2), 0x92);
+        const __m256 xy = _mm256_shuffle_ps(x, y, _MM_SHUFFLE(2, 0, 2, 0)); /* x0 x2 y0 y2 */
+        const __m256 yz = _mm256_shuffle_ps(y, z, _MM_SHUFFLE(3, 1, 3, 1)); /* y1 y3 z1 z3 */
+        const __m256 zx = _mm256_shuffle_ps(z, x, _MM_SHUFFLE(3, 1, 2, 0)); /* z0 z2 x1 x3 */
+        const __m256 r03 = _mm256_shuffle_ps(xy, zx, _MM_SHUFFLE(2, 0, 2, 0)); /* x0 y0 z0 x1 */
+        const __m256 r14 = _mm256_shuffle_ps(yz, xy, _MM_SHUFFLE(3, 1, 2, 0)); /* y1 z1 x2 y2 */
+        const __m256 r25 = _mm256_shuffle_ps(zx, yz, _MM_SHUFFLE(3, 1, 3, 1)); /* z2 x3 y3 z3 */
+        const __m256 a = _mm256_permute2f128_ps(r03, r14, 0x20);
+        const __m256 c = _mm256_permute2f128_ps(r25, r03, 0x30);
+        const __m256 e = _mm256_permute2f128_ps(r14, r25, 0x31);
         if (stream) {
             _mm256_stream_ps(o, a);
             _mm256_stream_ps(o + 8, c);
@@ -270,10 +269,7 @@ size_t POSE__KV(pose__transfer_blocks)(const pose__transfer_mesh *m, const float
         /* det D' = e1 . (e2 x e3) <= 0: the tet is flat or inside out (det D > 0 at rest) */
         const pose__v8f det = e1x * c23x + e1y * c23y + e1z * c23z;
         const pose__v8i bad = det <= 0.0f;
-        int any = 0;
-        for (int l = 0; l < 8; l++)
-            any |= bad[l];
-        if (any) {
+        if (V8_ANY(bad)) {
             size_t count = m->vertex_count - b * POSE__BLOCK;
             for (size_t l = 0; l < 8 && l < count; l++)
                 if (bad[l])

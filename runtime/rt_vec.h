@@ -42,6 +42,12 @@ typedef uint8_t pose__v8u8 __attribute__((vector_size(8)));
 #define V8_NEG_WHERE(w, neg)                                                        \
     ((pose__v8f)((pose__v8i)(w) ^ ((pose__v8i)((neg) < 0.0f) &                      \
                                    (pose__v8i)V8_SPLAT(-0.0f))))
+/* Nonzero when some lane of the comparison mask m is set. */
+#ifdef __AVX__
+#  define V8_ANY(m) _mm256_movemask_ps((__m256)(m))
+#else
+#  define V8_ANY(m) (((m)[0] | (m)[1] | (m)[2] | (m)[3]) | ((m)[4] | (m)[5] | (m)[6] | (m)[7]))
+#endif
 /* Keep x where cond holds, else +0. */
 #define V8_AND_MASK(x, cond) ((pose__v8f)((pose__v8i)(x) & (pose__v8i)(cond)))
 
