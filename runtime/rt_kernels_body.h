@@ -8,6 +8,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "rt_kernels.h"
 #include "rt_vec.h"
@@ -19,6 +20,33 @@
 #define joint_row(m, b, k) ((m)->joints + ((b) * (m)->influences + (k)) * POSE__BLOCK)
 /* Entry `off` of the palette rows of the joints in `row`. */
 #define PAL(row, off) V8_GATHER(pf, row, PAL_STRIDE, off)
+
+/* 1 when the eight lanes of joint row idx name the same joint: nearly every
+ * row of a body (vertices come in spatial order, so a block lies in one
+ * bone's region); its palette entries are then broadcast, not gathered lane
+ * by lane (same values, far fewer loads and inserts). */
+static POSE__INLINE int row_uniform(const uint16_t *idx)
+{
+    uint64_t lo, hi;
+    memcpy(&lo, idx, 8);
+    memcpy(&hi, idx + 4, 8);
+    const uint64_t all = (uint64_t)idx[0] * 0x0001000100010001ull;
+    return lo == all && hi == all;
+}
+
+/* out[i] = palette entry off + i of the rows' joints, i < n. */
+static POSE__INLINE void pal_load(const float *pf, const uint16_t *idx, int uniform, int off,
+                                  int n, pose__v8f *out)
+{
+    if (uniform) {
+        const float *j = pf + (size_t)idx[0] * PAL_STRIDE + off;
+        for (int i = 0; i < n; i++)
+            out[i] = V8_SPLAT(j[i]);
+    } else {
+        for (int i = 0; i < n; i++)
+            out[i] = PAL(idx, off + i);
+    }
+}
 
 /* Weights of influence k for the lanes of block b (a macro: vectors are not
  * passed by value, whose ABI differs between the variants). */
@@ -115,31 +143,31 @@ void POSE__KV(pose__skin_blocks)(int method, const pose__skin_mesh *m,
         const pose__v8f vz = *(const pose__v8f *)(rb + 16);
         const unsigned kb = m->active[b];
         const uint16_t *idx = joint_row(m, b, 0);
-        pose__v8f q0x = PAL(idx, 0), q0y = PAL(idx, 1);
-        pose__v8f q0z = PAL(idx, 2), q0w = PAL(idx, 3);
+        int uni = row_uniform(idx);
+        pose__v8f q0[4], qk[4], tk[4];
+        pal_load(pf, idx, uni, 0, 4, q0);
+        const pose__v8f q0x = q0[0], q0y = q0[1], q0z = q0[2], q0w = q0[3];
         pose__v8f ox, oy, oz, rx, ry, rz;
         if (kb == 1) {
             /* every lane bound to one joint: rigid, the same for all methods */
-            pose__v8f tx = PAL(idx, 4), ty = PAL(idx, 5);
-            pose__v8f tz = PAL(idx, 6);
+            pal_load(pf, idx, uni, 4, 3, tk);
             V8_ROTDISP(rx, ry, rz, q0x, q0y, q0z, q0w, vx, vy, vz);
-            ox = vx + (rx + tx);
-            oy = vy + (ry + ty);
-            oz = vz + (rz + tz);
+            ox = vx + (rx + tk[0]);
+            oy = vy + (ry + tk[1]);
+            oz = vz + (rz + tk[2]);
         } else if (method == POSE__SKIN_LBS) {
             /* v' = v + sum w (R v - v + t) */
             pose__v8f dx = V8_SPLAT(0.0f), dy = dx, dz = dx;
             for (unsigned k = 0; k < kb; k++) {
                 idx = joint_row(m, b, k);
+                uni = row_uniform(idx);
                 pose__v8f w = block_weights(m, b, k);
-                pose__v8f qx = PAL(idx, 0), qy = PAL(idx, 1);
-                pose__v8f qz = PAL(idx, 2), qw = PAL(idx, 3);
-                pose__v8f tx = PAL(idx, 4), ty = PAL(idx, 5);
-                pose__v8f tz = PAL(idx, 6);
-                V8_ROTDISP(rx, ry, rz, qx, qy, qz, qw, vx, vy, vz);
-                dx += w * (rx + tx);
-                dy += w * (ry + ty);
-                dz += w * (rz + tz);
+                pal_load(pf, idx, uni, 0, 4, qk);
+                pal_load(pf, idx, uni, 4, 3, tk);
+                V8_ROTDISP(rx, ry, rz, qk[0], qk[1], qk[2], qk[3], vx, vy, vz);
+                dx += w * (rx + tk[0]);
+                dy += w * (ry + tk[1]);
+                dz += w * (rz + tk[2]);
             }
             ox = vx + dx;
             oy = vy + dy;
@@ -150,15 +178,18 @@ void POSE__KV(pose__skin_blocks)(int method, const pose__skin_mesh *m,
             pose__v8f ex = bx, ey = bx, ez = bx, ew = bx;
             for (unsigned k = 0; k < kb; k++) {
                 idx = joint_row(m, b, k);
-                pose__v8f qx = PAL(idx, 0), qy = PAL(idx, 1);
-                pose__v8f qz = PAL(idx, 2), qw = PAL(idx, 3);
+                uni = row_uniform(idx);
+                pose__v8f dk[4];
+                pal_load(pf, idx, uni, 0, 4, qk);
+                pal_load(pf, idx, uni, 8, 4, dk);
+                const pose__v8f qx = qk[0], qy = qk[1], qz = qk[2], qw = qk[3];
                 pose__v8f dot = qx * q0x + qy * q0y + qz * q0z + qw * q0w;
                 pose__v8f w = V8_NEG_WHERE(block_weights(m, b, k), dot);
                 bx += w * qx; by += w * qy; bz += w * qz; bw += w * qw;
-                ex += w * PAL(idx, 8);
-                ey += w * PAL(idx, 9);
-                ez += w * PAL(idx, 10);
-                ew += w * PAL(idx, 11);
+                ex += w * dk[0];
+                ey += w * dk[1];
+                ez += w * dk[2];
+                ew += w * dk[3];
             }
             pose__v8f inv = 1.0f / V8_SQRT(bx * bx + by * by + bz * bz + bw * bw);
             bx *= inv; by *= inv; bz *= inv; bw *= inv;
@@ -182,16 +213,18 @@ void POSE__KV(pose__skin_blocks)(int method, const pose__skin_mesh *m,
             pose__v8f dx = bx, dy = bx, dz = bx;
             for (unsigned k = 0; k < kb; k++) {
                 idx = joint_row(m, b, k);
+                uni = row_uniform(idx);
                 pose__v8f w = block_weights(m, b, k);
-                pose__v8f qx = PAL(idx, 0), qy = PAL(idx, 1);
-                pose__v8f qz = PAL(idx, 2), qw = PAL(idx, 3);
+                pal_load(pf, idx, uni, 0, 4, qk);
+                pal_load(pf, idx, uni, 4, 3, tk);
+                const pose__v8f qx = qk[0], qy = qk[1], qz = qk[2], qw = qk[3];
                 pose__v8f dot = qx * q0x + qy * q0y + qz * q0z + qw * q0w;
                 pose__v8f ws = V8_NEG_WHERE(w, dot);
                 bx += ws * qx; by += ws * qy; bz += ws * qz; bw += ws * qw;
                 V8_ROTDISP(rx, ry, rz, qx, qy, qz, qw, cx, cy, cz);
-                dx += w * (rx + PAL(idx, 4));
-                dy += w * (ry + PAL(idx, 5));
-                dz += w * (rz + PAL(idx, 6));
+                dx += w * (rx + tk[0]);
+                dy += w * (ry + tk[1]);
+                dz += w * (rz + tk[2]);
             }
             pose__v8f inv = 1.0f / V8_SQRT(bx * bx + by * by + bz * bz + bw * bw);
             bx *= inv; by *= inv; bz *= inv; bw *= inv;
