@@ -3,7 +3,29 @@
 
 #include "rt_kernels.h"
 
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
 static int g_force_generic;
+
+#ifdef POSE__HAVE_AVX2_KERNELS
+/* POSE_KERNELS=generic in the environment forces the generic variant too,
+ * so a whole test suite or benchmark can be run through it on an AVX2
+ * machine. Read once (-1: not yet). */
+static _Atomic int g_env_generic = -1;
+
+static int env_generic(void)
+{
+    int v = atomic_load_explicit(&g_env_generic, memory_order_relaxed);
+    if (v < 0) {
+        const char *e = getenv("POSE_KERNELS");
+        v = e && !strcmp(e, "generic");
+        atomic_store_explicit(&g_env_generic, v, memory_order_relaxed);
+    }
+    return v;
+}
+#endif
 
 void pose__kernels_force_generic(int on)
 {
@@ -13,7 +35,7 @@ void pose__kernels_force_generic(int on)
 int pose__kernels_use_avx2(void)
 {
 #ifdef POSE__HAVE_AVX2_KERNELS
-    return !g_force_generic && __builtin_cpu_supports("avx2");
+    return !g_force_generic && !env_generic() && __builtin_cpu_supports("avx2");
 #else
     return 0;
 #endif

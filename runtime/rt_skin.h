@@ -65,7 +65,8 @@ void pose__skin(int method, const pose__skin_mesh *mesh, const pose__skin_joint 
 size_t pose__skin_bytes(int method, const pose__skin_mesh *mesh);
 
 /** Kernel variants: the generic C one always exists; others where built and
- *  supported by the CPU. Tests force the generic one to compare results. */
+ *  supported by the CPU. Tests force the generic one to compare results;
+ *  POSE_KERNELS=generic in the environment forces it for a whole process. */
 void pose__kernels_force_generic(int on);
 /** Name of the variant in use ("avx2" or "generic"). */
 const char *pose__kernels_variant(void);
