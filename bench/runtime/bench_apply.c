@@ -6,6 +6,9 @@
  * STREAM triad measured in the same run with the same thread count:
  *   bound = triad bytes/s / bytes per frame (fps if memory were the only limit)
  *   ratio = fps / bound.
+ * With --passes, also the mean time of each pass of a frame (skinning,
+ * transfer with normals, triangle normals of flat tets), run as pose_apply
+ * runs them, to see where a frame goes.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,21 +25,26 @@ typedef struct options {
     double seconds;      /* timed run per configuration */
     const char *rigs;    /* comma list: small,medium,body */
     int max_threads;
+    int passes;          /* also time each pass of pose_apply */
 } options;
 
 static void usage(FILE *f)
 {
     fprintf(f,
             "usage: bench_apply [--json] [--seconds S] [--rigs small,medium,body] [--threads N]\n"
+            "                   [--passes]\n"
             "  Frames per second of pose_apply per rig, method and thread count (1..N,\n"
             "  default 2), bytes per frame, STREAM triad bandwidth and achieved/bound.\n"
             "  --seconds S   timed run per configuration (default 1.0)\n"
-            "  --json        one JSON object on stdout instead of the table\n");
+            "  --json        one JSON object on stdout instead of the table\n"
+            "  --passes      also the mean ms of pose_apply and of each of its passes:\n"
+            "                skin, transfer (with normals), fix (triangle normals of flat tets)\n"
+            "  POSE_KERNELS=generic in the environment times the generic kernels.\n");
 }
 
 static int parse(int argc, char **argv, options *o)
 {
-    *o = (options){0, 1.0, "small,medium,body", 2};
+    *o = (options){0, 1.0, "small,medium,body", 2, 0};
     for (int i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             usage(stdout);
@@ -47,6 +55,8 @@ static int parse(int argc, char **argv, options *o)
             o->seconds = atof(argv[++i]);
         } else if (!strcmp(argv[i], "--rigs") && i + 1 < argc) {
             o->rigs = argv[++i];
+        } else if (!strcmp(argv[i], "--passes")) {
+            o->passes = 1;
         } else if (!strcmp(argv[i], "--threads") && i + 1 < argc) {
             o->max_threads = atoi(argv[++i]);
         } else {
@@ -97,11 +107,68 @@ static void set_frame_pose(pose_state *st, size_t joints, int frame)
     }
 }
 
+/* The passes of pose_apply, split over the pool as sdk/src/state.c splits
+ * them (same kernels, same ranges), for --passes. */
+static void pass_skin(void *ctx, unsigned part, unsigned parts)
+{
+    pose_state *st = ctx;
+    const pose__skin_mesh *m = &st->rt->skin;
+    pose__skin((int)st->method, m, st->palette, pose__part_begin(m->block_count, part, parts),
+               pose__part_begin(m->block_count, part + 1, parts), st->tet_positions);
+}
+
+static void pass_transfer(void *ctx, unsigned part, unsigned parts)
+{
+    pose_state *st = ctx;
+    const pose__transfer_mesh *m = &st->rt->transfer;
+    size_t b = pose__part_begin(m->block_count, part, parts);
+    st->flagged_count[part] =
+        pose__transfer(m, st->tet_positions, b, pose__part_begin(m->block_count, part + 1, parts),
+                       st->tissue_positions, st->tissue_normals, st->flagged + b * POSE__BLOCK);
+}
+
+static void pass_fix(void *ctx, unsigned part, unsigned parts)
+{
+    pose_state *st = ctx;
+    const pose__transfer_mesh *m = &st->rt->transfer;
+    size_t b = pose__part_begin(m->block_count, part, parts);
+    pose__transfer_fix_normals(m, st->tissue_positions, st->flagged + b * POSE__BLOCK,
+                               st->flagged_count[part], st->tissue_normals);
+}
+
+/* Mean seconds of pose_apply (out[3]) and of each of its passes (out[0..2])
+ * over `frames` posed frames: pose_apply is timed, then its passes run
+ * again, each timed (same machine state, so the shares compare). */
+static void time_passes(pose_state *st, size_t joints, int frames, double out[4])
+{
+    const size_t blocks = st->rt->skin.block_count + st->rt->transfer.block_count;
+    const int serial = blocks < POSE__SERIAL_BLOCKS;
+    const pose__task_fn fns[3] = {pass_skin, pass_transfer, pass_fix};
+    out[0] = out[1] = out[2] = out[3] = 0.0;
+    for (int f = 0; f < frames; f++) {
+        set_frame_pose(st, joints, f);
+        const double a0 = bench_now();
+        pose_apply(st);
+        out[3] += bench_now() - a0;
+        for (int p = 0; p < 3; p++) {
+            double t0 = bench_now();
+            if (serial)
+                fns[p](st, 0, 1);
+            else
+                pose__pool_run(st->pool, fns[p], st);
+            out[p] += bench_now() - t0;
+        }
+    }
+    for (int p = 0; p < 4; p++)
+        out[p] /= frames;
+}
+
 typedef struct result {
     const char *rig;
     const char *method;
     int threads;
     double fps, cpu_fps, bytes, triad, bound, ratio;
+    double pass_s[4]; /* --passes: skin, transfer, fix, whole pose_apply */
     size_t tet_vertices, tets, tissue_vertices;
 } result;
 
@@ -181,6 +248,9 @@ int main(int argc, char **argv)
                 r->tet_vertices = ti.vertex_count;
                 r->tets = ti.tet_count;
                 r->tissue_vertices = tissue;
+                if (o.passes)
+                    time_passes(st, nj, frames < 20 ? 20 : frames > 2000 ? 2000 : frames,
+                                r->pass_s);
                 pose_state_free(st);
             }
         }
@@ -194,9 +264,15 @@ int main(int argc, char **argv)
             printf("%s\n  {\"rig\": \"%s\", \"method\": \"%s\", \"threads\": %d, "
                    "\"tet_vertices\": %zu, \"tets\": %zu, \"tissue_vertices\": %zu, "
                    "\"fps\": %.1f, \"fps_per_cpu_time\": %.1f, \"bytes_per_frame\": %.0f, \"triad_bytes_per_s\": %.0f, "
-                   "\"bound_fps\": %.1f, \"ratio\": %.3f}",
+                   "\"bound_fps\": %.1f, \"ratio\": %.3f",
                    i ? "," : "", r->rig, r->method, r->threads, r->tet_vertices, r->tets,
                    r->tissue_vertices, r->fps, r->cpu_fps, r->bytes, r->triad, r->bound, r->ratio);
+            if (o.passes)
+                printf(", \"pass_ms\": {\"apply\": %.4f, \"skin\": %.4f, \"transfer\": %.4f, "
+                       "\"fix\": %.4f}",
+                       1e3 * r->pass_s[3], 1e3 * r->pass_s[0], 1e3 * r->pass_s[1],
+                       1e3 * r->pass_s[2]);
+            printf("}");
         }
         printf("\n]}\n");
         return 0;
@@ -209,6 +285,20 @@ int main(int argc, char **argv)
         printf("%-7s %-4s %3d %9zu %10zu %9.1f %9.1f %10.2f %11.2f %6.0f%%\n", r->rig, r->method,
                r->threads, r->tet_vertices, r->tissue_vertices, r->fps, r->cpu_fps, r->bytes / 1e6,
                r->triad / 1e9, 100.0 * r->ratio);
+    }
+    if (o.passes) {
+        printf("\nmean ms of pose_apply and of its passes, timed in turn over the same frames\n"
+               "(other = apply - passes: FK, palette, hand-offs; noisy on a shared machine)\n");
+        printf("%-7s %-4s %3s %9s %9s %9s %9s %9s\n", "rig", "meth", "thr", "apply", "skin",
+               "transfer", "fix", "other");
+        for (int i = 0; i < nres; i++) {
+            const result *r = &res[i];
+            const double frame = 1e3 * r->pass_s[3];
+            const double sum = 1e3 * (r->pass_s[0] + r->pass_s[1] + r->pass_s[2]);
+            printf("%-7s %-4s %3d %9.4f %9.4f %9.4f %9.4f %9.4f\n", r->rig, r->method, r->threads,
+                   frame, 1e3 * r->pass_s[0], 1e3 * r->pass_s[1], 1e3 * r->pass_s[2],
+                   frame - sum);
+        }
     }
     printf("ratio = fps / (triad bytes/s / bytes per frame): the share of the memory-bound\n"
            "frame rate reached. Bytes count each streamed array once (reads + writes).\n"

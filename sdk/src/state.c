@@ -9,10 +9,6 @@
 #include "rt_transfer.h"
 #include "state_internal.h"
 
-/* Below this many blocks of 8 vertices (skin + transfer), pose_apply does
- * not use the workers: ~16 k vertices take about as long as a wake-up. */
-#define POSE__SERIAL_BLOCKS 2048
-
 static size_t align64(size_t n)
 {
     return (n + 63u) & ~(size_t)63u;

@@ -38,6 +38,11 @@ struct pose_state {
     void *block;                /**< the allocation holding everything else */
 };
 
+/** Below this many blocks of 8 vertices (skin + transfer), pose_apply does
+ *  not use the workers: ~16 k vertices take about as long as a wake-up of a
+ *  sleeping worker. */
+#define POSE__SERIAL_BLOCKS 2048
+
 /** Most worker threads a state runs. */
 #define POSE__MAX_THREADS 256
 
