@@ -11,7 +11,7 @@
  * is a halted virtual CPU, more than a whole pass over a medium rig; polling
  * a little longer than that keeps back-to-back passes (and frames) free of
  * wake-ups, and an idle pool still ends up asleep. */
-#define SPIN_NS 200000L
+#define SPIN_NS 200000
 /* Polls between clock reads. */
 #define SPIN_CHECK 64
 
@@ -48,17 +48,17 @@ static inline void cpu_relax(void)
 #endif
 }
 
-static long now_ns(void)
+static int64_t now_ns(void)
 {
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
-    return (long)t.tv_sec * 1000000000L + t.tv_nsec;
+    return (int64_t)t.tv_sec * 1000000000 + t.tv_nsec;
 }
 
 /* Poll until *gen differs from seen (1) or SPIN_NS pass (0). */
 static int spin_for_generation(pose__pool *p, uint64_t seen)
 {
-    long deadline = now_ns() + SPIN_NS;
+    const int64_t deadline = now_ns() + SPIN_NS;
     for (;;) {
         for (int i = 0; i < SPIN_CHECK; i++) {
             if (atomic_load_explicit(&p->generation, memory_order_acquire) != seen)
@@ -73,7 +73,7 @@ static int spin_for_generation(pose__pool *p, uint64_t seen)
 /* Poll until every worker is done (1) or SPIN_NS pass (0). */
 static int spin_for_done(pose__pool *p)
 {
-    long deadline = now_ns() + SPIN_NS;
+    const int64_t deadline = now_ns() + SPIN_NS;
     for (;;) {
         for (int i = 0; i < SPIN_CHECK; i++) {
             if (atomic_load_explicit(&p->pending, memory_order_acquire) == 0)

@@ -7,6 +7,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <time.h>
 
 #include <cmocka.h>
 
@@ -56,6 +57,51 @@ static void test_pool_runs_every_part_once(void **unused)
     }
 }
 
+static void sleep_ms(long ms)
+{
+    struct timespec t = {0, ms * 1000000L};
+    nanosleep(&t, NULL);
+}
+
+/* A part that outlasts the pool's polling (~0.2 ms) when the round says so:
+ * the caller then waits on the condition variable instead of polling. */
+static void slow_task(void *ctx, unsigned part, unsigned parts)
+{
+    job *j = ctx;
+    if (part == parts - 1 && j->round % 4 == 0)
+        sleep_ms(2);
+    task(ctx, part, parts);
+}
+
+/* Workers poll for a while after a task, then sleep: tasks posted after a
+ * pause (sleeping workers), back to back (polling workers), and parts that
+ * finish long after the caller's all run exactly once and are seen whole. */
+static void test_pool_sleeps_and_wakes(void **unused)
+{
+    (void)unused;
+    for (unsigned threads = 2; threads <= 3; threads++) {
+        pose__pool *pool = aligned_alloc(64, (pose__pool_size(threads) + 63) & ~(size_t)63);
+        assert_non_null(pool);
+        assert_int_equal(pose__pool_init(pool, threads), 0);
+        job *j = calloc(1, sizeof *j);
+        for (int r = 1; r <= 24; r++) {
+            if (r % 3 == 0)
+                sleep_ms(2); /* longer than the polling: the workers are asleep */
+            j->round = r;
+            pose__pool_run(pool, slow_task, j);
+            for (unsigned p = 0; p < threads; p++) {
+                assert_int_equal(j->seen[p], r);
+                assert_int_equal(j->runs[p], r);
+            }
+        }
+        for (size_t i = 0; i < ITEMS; i++)
+            assert_int_equal(j->data[i], 24 * (int)i);
+        free(j);
+        pose__pool_destroy(pool);
+        free(pool);
+    }
+}
+
 static void test_part_ranges_cover(void **unused)
 {
     (void)unused;
@@ -73,6 +119,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_part_ranges_cover),
         cmocka_unit_test(test_pool_runs_every_part_once),
+        cmocka_unit_test(test_pool_sleeps_and_wakes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
