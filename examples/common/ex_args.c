@@ -117,6 +117,60 @@ bad:
     return -1;
 }
 
+int ex_parse_times(const char *opt, const char *s, double **times, size_t *count, char *err, size_t err_size)
+{
+    size_t cap = 0;
+    *times = NULL;
+    *count = 0;
+    const char *p = s;
+    for (;;) {
+        char *end;
+        double first = strtod(p, &end), last = first, step = 1.0;
+        if (end == p || !isfinite(first) || first < 0.0)
+            goto bad;
+        p = end;
+        if (*p == '-') {
+            last = strtod(p + 1, &end);
+            if (end == p + 1 || !isfinite(last) || last < first || *end != ':')
+                goto bad;
+            p = end + 1;
+            step = strtod(p, &end);
+            if (end == p || !isfinite(step) || step <= 0.0)
+                goto bad;
+            p = end;
+        }
+        double n = floor((last - first) / step + 1e-9) + 1.0; /* 0-5:0.5 takes 5 despite rounding */
+        if (n + (double)*count > 100000.0) {
+            snprintf(err, err_size, "%s: '%s' asks for more than 100000 times", opt, s);
+            goto fail;
+        }
+        if (*count + (size_t)n > cap) {
+            size_t nc = 2 * (*count + (size_t)n);
+            double *nt = realloc(*times, nc * sizeof *nt);
+            if (!nt) {
+                snprintf(err, err_size, "%s: out of memory", opt);
+                goto fail;
+            }
+            *times = nt;
+            cap = nc;
+        }
+        for (size_t k = 0; k < (size_t)n; k++)
+            (*times)[(*count)++] = first + (double)k * step;
+        if (*p == '\0')
+            return 0;
+        if (*p != ',')
+            goto bad;
+        p++;
+    }
+bad:
+    snprintf(err, err_size, "%s: expected seconds as 0,2.5,5 or 0-10:0.5 (first-last:step), got '%s'", opt, s);
+fail:
+    free(*times);
+    *times = NULL;
+    *count = 0;
+    return -1;
+}
+
 void ex_json_string(void *file, const char *s)
 {
     FILE *f = file;

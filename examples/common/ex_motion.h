@@ -6,7 +6,8 @@
  * adapter over the bridge library. Builds without the bridge get a stub that
  * refuses every source and says why.
  *
- * Two ways to drive: frame by frame (clips only; for images), or live, where
+ * Two ways to drive: frame by frame (clips) or by recorded time (clips and
+ * recordings), for images; or live, where
  * the bridge's own thread plays the source in real time and publishes joint
  * targets through its lock-free hand-off, and the host's frame loop picks up
  * the newest pose without waiting (ex_motion_start / ex_motion_poll).
@@ -39,6 +40,15 @@ long ex_motion_frame_count(const ex_motion *m);
 double ex_motion_frame_time(const ex_motion *m);
 /** Set the state's joints to clip frame `frame` (pose_apply is the caller's). Clips only. */
 int ex_motion_set_frame(ex_motion *m, pose_state *st, long frame, char *err, size_t err_size);
+
+/**
+ * Set the state's joints to the pose held at `t_s` seconds of recorded time
+ * (pose_apply is the caller's). Recordings (.hid, candump .log) replay as fast
+ * as possible through the same decoder and mapping as live play, up to t_s;
+ * a later time continues, an earlier one replays from the start. Clips take
+ * the frame at t_s. Live devices are refused.
+ */
+int ex_motion_set_time(ex_motion *m, pose_state *st, double t_s, char *err, size_t err_size);
 
 /** Start live playback on the bridge thread (clips and recordings loop). */
 int ex_motion_start(ex_motion *m, char *err, size_t err_size);

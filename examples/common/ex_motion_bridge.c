@@ -32,6 +32,16 @@ struct ex_motion {
     pb_pose pose;
     double (*lq)[4], (*lt)[3];
     pb_runner *runner;
+    /* --times: a second, as-fast-as-possible replay of a recording, fed up
+     * to each requested time; the first update past it waits in next_*. */
+    char spec[1024], map_path[1024];
+    pb_source *scrub;
+    pb_chanmap *scrub_cm;
+    int64_t scrub_t0, scrub_last;
+    int scrub_started, have_next;
+    pb_update next;
+    uint32_t *next_ch;
+    double *next_val;
     int paused;
     char status[512];
 };
@@ -65,18 +75,19 @@ static int open_clip(ex_motion *m, const char *source, pb_error *pe, char *err, 
     return 0;
 }
 
-/* CAN: a candump -l log, or "can:IFACE" / an interface name; the bus comes from the mapping's "can". */
-static int open_can(ex_motion *m, const char *source, const char *map, pb_error *pe)
+/* CAN: a candump -l log, or "can:IFACE" / an interface name; the bus comes from the mapping's "can".
+ * Logs loop for live play; scrub = once through, as fast as possible (--times). */
+static int open_can(const char *source, const char *map, int scrub, pb_source **out, pb_error *pe)
 {
     pb_can_bus *bus = NULL;
     if (pb_can_bus_load(map, &bus, pe) < 0)
         return -1;
     if (ends_with(source, ".log")) {
-        pb_candump_replay_options opt = {.loop = 1};
-        return pb_candump_replay_open(source, bus, &opt, &m->src, pe) < 0 ? -1 : 0;
+        pb_candump_replay_options opt = {.loop = !scrub, .as_fast_as_possible = scrub};
+        return pb_candump_replay_open(source, bus, &opt, out, pe) < 0 ? -1 : 0;
     }
     const char *iface = !strncmp(source, "can:", 4) ? source + 4 : source;
-    return pb_can_live_open(iface, bus, NULL, &m->src, pe) < 0 ? -1 : 0;
+    return pb_can_live_open(iface, bus, NULL, out, pe) < 0 ? -1 : 0;
 }
 
 /* What kind of source a command-line spec names: 'c' clip, 'h' HID, 'n' CAN, 0 unknown. */
@@ -115,6 +126,8 @@ int ex_motion_open(const char *source, const char *map, const pose_rig *rig, ex_
         return -1;
     }
     snprintf(m->name, sizeof m->name, "%s", strrchr(source, '/') ? strrchr(source, '/') + 1 : source);
+    snprintf(m->spec, sizeof m->spec, "%s", source);
+    snprintf(m->map_path, sizeof m->map_path, "%s", map ? map : "");
     int rc = (map ? pb_mapping_load(map, &m->map, &pe) : pb_mapping_identity(&m->map, &pe)) < 0 ||
                      pb_rig_skel_from_rig(rig, &m->skel, &pe) < 0
                  ? -1
@@ -123,7 +136,7 @@ int ex_motion_open(const char *source, const char *map, const pose_rig *rig, ex_
         if (clip)
             rc = open_clip(m, source, &pe, err, err_size);
         else if (kind == 'n')
-            rc = open_can(m, source, map, &pe);
+            rc = open_can(source, map, 0, &m->src, &pe);
         else
             rc = pb_hid_open(source, &(pb_hid_replay_options){.loop = 1}, &m->src, &pe) < 0 ? -1 : 0;
     }
@@ -147,11 +160,61 @@ int ex_motion_open(const char *source, const char *map, const pose_rig *rig, ex_
     return 0;
 }
 
+static void scrub_close(ex_motion *m)
+{
+    pb_chanmap_free(m->scrub_cm);
+    pb_source_destroy(m->scrub);
+    m->scrub_cm = NULL;
+    m->scrub = NULL;
+}
+
+/* (Re)start the scrub replay at the recording's beginning: a fresh source and
+ * channel mapping, so filters start from the same state as live play. */
+static int scrub_open(ex_motion *m, char *err, size_t err_size)
+{
+    pb_error pe = {{0}};
+    int rc;
+    scrub_close(m);
+    if (source_kind(m->spec) == 'n')
+        rc = open_can(m->spec, m->map_path, 1, &m->scrub, &pe);
+    else
+        rc = pb_hid_open(m->spec, &(pb_hid_replay_options){.as_fast_as_possible = 1}, &m->scrub, &pe);
+    if (rc == 0)
+        rc = pb_chanmap_create(m->map, m->scrub->channels, m->scrub->channel_count, m->skel, &m->scrub_cm, &pe);
+    if (rc == 0 && !m->next_ch) {
+        m->next_ch = calloc(m->scrub->channel_count + 1, sizeof *m->next_ch);
+        m->next_val = calloc(m->scrub->channel_count + 1, sizeof *m->next_val);
+        if (!m->next_ch || !m->next_val) {
+            snprintf(err, err_size, "out of memory");
+            return -1;
+        }
+    }
+    if (rc < 0) {
+        snprintf(err, err_size, "%s", pe.message[0] ? pe.message : "cannot replay the recording");
+        return -1;
+    }
+    m->scrub_started = m->have_next = 0;
+    m->scrub_last = 0;
+    return 0;
+}
+
+/* Keep an update past the requested time for the next request (the source
+ * owns its arrays only until the next read). */
+static void hold_next(ex_motion *m, const pb_update *u)
+{
+    size_t n = u->count <= m->scrub->channel_count ? u->count : m->scrub->channel_count;
+    memcpy(m->next_ch, u->channels, n * sizeof *m->next_ch);
+    memcpy(m->next_val, u->values, n * sizeof *m->next_val);
+    m->next = (pb_update){.t_ns = u->t_ns, .count = n, .channels = m->next_ch, .values = m->next_val};
+    m->have_next = 1;
+}
+
 void ex_motion_close(ex_motion *m)
 {
     if (!m)
         return;
     pb_runner_stop(m->runner, NULL); /* destroys a source it was given */
+    scrub_close(m);
     if (!m->runner)
         pb_source_destroy(m->src);
     pb_pose_free(&m->pose);
@@ -161,6 +224,8 @@ void ex_motion_close(ex_motion *m)
     pb_clip_free(m->clip);
     free(m->lq);
     free(m->lt);
+    free(m->next_ch);
+    free(m->next_val);
     free(m);
 }
 
@@ -177,8 +242,8 @@ double ex_motion_frame_time(const ex_motion *m)
 int ex_motion_set_frame(ex_motion *m, pose_state *st, long frame, char *err, size_t err_size)
 {
     if (!m->clip) {
-        snprintf(err, err_size, "%s: a device source or recording has no frames to pick; play it live "
-                                "(pose-view, pose-bridge)", m->name);
+        snprintf(err, err_size, "%s: a device source or recording has no frames to pick; pick recorded "
+                                "times (--times), or play it live (pose-view, pose-bridge)", m->name);
         return -1;
     }
     if (frame < 0 || (size_t)frame >= m->clip->frame_count) {
@@ -190,6 +255,60 @@ int ex_motion_set_frame(ex_motion *m, pose_state *st, long frame, char *err, siz
     pb_retarget_apply(m->rt, (const double(*)[4])m->lq, (const double(*)[3])m->lt, 0.0, &m->pose);
     if (pb_pose_apply_to_state(&m->pose, st, NULL) < 0) {
         snprintf(err, err_size, "cannot apply frame %ld: %s", frame, pose_last_error());
+        return -1;
+    }
+    return 0;
+}
+
+int ex_motion_set_time(ex_motion *m, pose_state *st, double t_s, char *err, size_t err_size)
+{
+    if (m->clip) {
+        long f = (long)(t_s / m->clip->frame_time + 1e-9);
+        return ex_motion_set_frame(m, st, f < (long)m->clip->frame_count ? f : (long)m->clip->frame_count, err,
+                                   err_size);
+    }
+    if (!ends_with(m->spec, ".hid") && !ends_with(m->spec, ".log")) {
+        snprintf(err, err_size, "%s: a live device has no recorded time to pick; play it live (pose-view)", m->name);
+        return -1;
+    }
+    const int64_t want = (int64_t)(t_s * 1e9 + 0.5);
+    if ((!m->scrub || (m->scrub_started && want < m->scrub_last)) && scrub_open(m, err, err_size) < 0)
+        return -1;
+    /* Feed every update up to the requested time; faults the replay reports
+     * (a silent node, bus-off) are the recording's and play on, as live. */
+    for (int misses = 0;;) {
+        pb_update u;
+        if (m->have_next) {
+            u = m->next;
+        } else {
+            int got = pb_source_read(m->scrub, &u, 1000);
+            if (got <= 0) {
+                if (m->scrub->state == PB_SOURCE_ENDED || ++misses > 10000) {
+                    snprintf(err, err_size, "%s: %.3f s is past the end of the recording (%.3f s)", m->name, t_s,
+                             (double)m->scrub_last * 1e-9);
+                    return -1;
+                }
+                continue;
+            }
+            misses = 0;
+        }
+        if (!m->scrub_started) {
+            m->scrub_t0 = u.t_ns;
+            m->scrub_started = 1;
+        }
+        if (u.t_ns - m->scrub_t0 > want) {
+            if (!m->have_next)
+                hold_next(m, &u);
+            break;
+        }
+        m->have_next = 0;
+        pb_chanmap_update(m->scrub_cm, &u);
+        m->scrub_last = u.t_ns - m->scrub_t0;
+    }
+    pb_chanmap_pose(m->scrub_cm, &m->pose);
+    m->pose.media_s = t_s;
+    if (pb_pose_apply_to_state(&m->pose, st, NULL) < 0) {
+        snprintf(err, err_size, "cannot apply the pose at %.3f s: %s", t_s, pose_last_error());
         return -1;
     }
     return 0;

@@ -48,6 +48,12 @@ int ex_motion_set_frame(ex_motion *m, pose_state *st, long frame, char *err, siz
     return -1;
 }
 
+int ex_motion_set_time(ex_motion *m, pose_state *st, double t_s, char *err, size_t err_size)
+{
+    (void)t_s;
+    return ex_motion_set_frame(m, st, 0, err, err_size);
+}
+
 int ex_motion_start(ex_motion *m, char *err, size_t err_size)
 {
     return ex_motion_set_frame(m, NULL, 0, err, err_size);

@@ -16,10 +16,14 @@ void ex_render_usage(FILE *f)
           "  --source FILE --frames LIST  one image per frame of a replayed source (BVH, ASF/AMC,\n"
           "                               HID or CAN recording) driven through the bridge;\n"
           "                               LIST as 0,30,60 or 0-120:10\n"
+          "  --source FILE --times LIST   one image per recorded time (seconds): the recording is\n"
+          "                               replayed as fast as possible through the bridge's decoder\n"
+          "                               and mapping, and the pose held at each time is shown;\n"
+          "                               LIST as 0,2.5,5 or 0-10:0.5 (HID and CAN recordings, clips)\n"
           "  --map FILE                   the bridge mapping file for --source\n"
           "  --turntable N                N images around the model\n"
           "  --compare                    one image: LBS | DQS | CoR side by side, same pose (of\n"
-          "                               --pose, or of one --frames frame of --source)\n"
+          "                               --pose, or of one --frames frame or --times time of --source)\n"
           "Pose and look:\n"
           "  --pose JOINT=RX,RY,RZ        set a joint (degrees, XYZ order; repeatable)\n"
           "  --method lbs|dqs|cor         skinning method (default: cor when the rig has CoR data)\n"
@@ -145,6 +149,10 @@ int ex_render_parse(int argc, char **argv, ex_render_options *o, char *err, size
             free(o->frames);
             if (ex_parse_frames(a, v, &o->frames, &o->frame_count, err, err_size) < 0)
                 return -1;
+        } else if (!strcmp(a, "--times")) {
+            free(o->times);
+            if (ex_parse_times(a, v, &o->times, &o->time_count, err, err_size) < 0)
+                return -1;
         } else if (!strcmp(a, "--turntable")) {
             if (ex_parse_long(a, v, 1, 3600, &l, err, err_size) < 0)
                 return -1;
@@ -208,17 +216,22 @@ int ex_render_parse(int argc, char **argv, ex_render_options *o, char *err, size
         return -1;
     }
     int modes = (o->source != NULL) + (o->turntable > 0) + o->compare;
-    if (modes > 1 && !(modes == 2 && o->compare && o->source && o->frame_count == 1)) {
+    if (modes > 1 && !(modes == 2 && o->compare && o->source && o->frame_count + o->time_count == 1)) {
         snprintf(err, err_size, "choose one of --source, --turntable, --compare (--compare takes --source with "
-                                "one frame)");
+                                "one frame or time)");
         return -1;
     }
-    if (o->frames && !o->source) {
-        snprintf(err, err_size, "--frames needs --source");
+    if (o->frames && o->times) {
+        snprintf(err, err_size, "choose one of --frames, --times");
         return -1;
     }
-    if (o->source && !o->frames) {
-        snprintf(err, err_size, "--source needs --frames (e.g. --frames 0,30,60)");
+    if ((o->frames || o->times) && !o->source) {
+        snprintf(err, err_size, "%s needs --source", o->frames ? "--frames" : "--times");
+        return -1;
+    }
+    if (o->source && !o->frames && !o->times) {
+        snprintf(err, err_size, "--source needs --frames (e.g. --frames 0,30,60) or, for recordings, --times "
+                                "(seconds, e.g. --times 0,2.5,5)");
         return -1;
     }
     if (o->height - ex_render_caption_band(o) - ex_render_label_band(o) < 16) {

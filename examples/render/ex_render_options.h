@@ -22,6 +22,8 @@ typedef struct ex_render_options {
     int method; /* -1: CoR when the rig has it, else LBS */
     long *frames;
     size_t frame_count;
+    double *times; /* --times: seconds of recorded time, instead of frames */
+    size_t time_count;
     double azimuth, elevation, zoom;
     int have_azimuth, have_elevation;
     unsigned hide; /* bit per pose_tissue_kind */
@@ -32,7 +34,7 @@ typedef struct ex_render_options {
 void ex_render_usage(FILE *f);
 
 /**
- * Parse argv into o (o->frames is allocated: free it). Returns 0, 1 when
+ * Parse argv into o (o->frames and o->times are allocated: free them). Returns 0, 1 when
  * --help was printed, or -1 with a message in err.
  */
 int ex_render_parse(int argc, char **argv, ex_render_options *o, char *err, size_t err_size);

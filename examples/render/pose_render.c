@@ -97,7 +97,7 @@ typedef struct summary {
     double start; /* ex_now() at the first image */
 } summary;
 
-static int emit(summary *s, const ex_image *img, const char *path, long frame, const char *method,
+static int emit(summary *s, const ex_image *img, const char *path, long frame, double time_s, const char *method,
                 double render_ms, double apply_ms, char *err, size_t err_size)
 {
     if (ex_image_write_png(img, path, err, err_size) < 0)
@@ -109,8 +109,10 @@ static int emit(summary *s, const ex_image *img, const char *path, long frame, c
     if (s->json) {
         fprintf(s->json, "%s\n    {\"path\": ", s->first ? "" : ",");
         ex_json_string(s->json, path);
-        fprintf(s->json, ", \"frame\": %ld, \"method\": \"%s\", \"coverage\": %.4f, \"apply_ms\": %.3f}", frame,
-                method, cov, apply_ms);
+        fprintf(s->json, ", \"frame\": %ld, ", frame);
+        if (time_s >= 0.0)
+            fprintf(s->json, "\"time_s\": %.6g, ", time_s);
+        fprintf(s->json, "\"method\": \"%s\", \"coverage\": %.4f, \"apply_ms\": %.3f}", method, cov, apply_ms);
         s->first = 0;
     }
     /* Progress: in the text output's own lines, or on stderr beside JSON when it is a terminal. */
@@ -248,10 +250,24 @@ static int prepare(job *jb)
     return ex_scene_apply(sc, jb->err, jb->err_size);
 }
 
-/* Set a frame of the source and pose it. */
-static int pose_frame(job *jb, long frame)
+/* How many frames (--frames) or recorded times (--times) were asked for. */
+static size_t pick_count(const ex_render_options *o)
 {
-    if (ex_motion_set_frame(jb->motion, jb->sc.state, frame, jb->err, jb->err_size) < 0)
+    return o->times ? o->time_count : o->frame_count;
+}
+
+/* Set the i-th requested frame or time of the source (no pose_apply). */
+static int set_pick(job *jb, size_t i)
+{
+    const ex_render_options *o = jb->o;
+    return o->times ? ex_motion_set_time(jb->motion, jb->sc.state, o->times[i], jb->err, jb->err_size)
+                    : ex_motion_set_frame(jb->motion, jb->sc.state, o->frames[i], jb->err, jb->err_size);
+}
+
+/* Set the i-th requested frame or time of the source and pose it. */
+static int pose_pick(job *jb, size_t i)
+{
+    if (set_pick(jb, i) < 0)
         return -1;
     return ex_scene_apply(&jb->sc, jb->err, jb->err_size);
 }
@@ -263,9 +279,9 @@ static int frame_camera(job *jb)
     ex_scene *sc = &jb->sc;
     ex_scene_bounds(sc, !o->fit_rest, jb->bmin, jb->bmax);
     if (jb->motion && !o->fit_rest)
-        for (size_t i = 0; i < o->frame_count; i++) {
+        for (size_t i = 0; i < pick_count(o); i++) {
             float a[3], b[3];
-            if (pose_frame(jb, o->frames[i]) < 0)
+            if (pose_pick(jb, i) < 0)
                 return -1;
             ex_scene_bounds(sc, 1, a, b);
             for (int k = 0; k < 3; k++) {
@@ -309,7 +325,7 @@ static int render_compare(job *jb)
     ex_image panel = {0};
     double apply = 0.0, t0 = ex_now();
     int rc = -1;
-    if (jb->motion && ex_motion_set_frame(jb->motion, jb->sc.state, o->frames[0], jb->err, jb->err_size) < 0)
+    if (jb->motion && set_pick(jb, 0) < 0)
         return -1;
     if (ex_image_init(&panel, 3 * o->width, o->height, bg8) < 0) {
         snprintf(jb->err, jb->err_size, "out of memory");
@@ -333,20 +349,20 @@ static int render_compare(job *jb)
         ex_image_blit(&panel, &jb->img, m * o->width, 0);
     }
     caption(&panel, o->caption);
-    rc = emit(jb->s, &panel, jb->out, -1, "LBS|DQS|CoR", 1e3 * (ex_now() - t0), apply, jb->err, jb->err_size);
+    rc = emit(jb->s, &panel, jb->out, -1, -1.0, "LBS|DQS|CoR", 1e3 * (ex_now() - t0), apply, jb->err, jb->err_size);
 done:
     ex_image_free(&panel);
     return rc;
 }
 
-/* One image per requested frame of the source. */
+/* One image per requested frame or recorded time of the source. */
 static int render_frames(job *jb)
 {
     const ex_render_options *o = jb->o;
-    for (size_t i = 0; i < o->frame_count; i++) {
-        char text[512], path[4096];
+    for (size_t i = 0; i < pick_count(o); i++) {
+        char text[512], what[64], path[4096];
         double t0 = ex_now();
-        if (pose_frame(jb, o->frames[i]) < 0)
+        if (pose_pick(jb, i) < 0)
             return -1;
         if (o->follow) { /* the same size of box every frame: the distance stays, the target moves */
             float a[3], b[3];
@@ -359,12 +375,18 @@ static int render_frames(job *jb)
             setup_camera(&jb->cam, o, jb->bmin, jb->bmax, a, b, aspect(o));
         }
         render_to(&jb->r, o, &jb->sc, &jb->cam, &jb->img);
-        snprintf(text, sizeof text, "%s%sframe %ld  %s", o->caption ? o->caption : "", o->caption ? "  " : "",
-                 o->frames[i], ex_method_name(jb->method));
+        if (o->times) {
+            snprintf(what, sizeof what, "t %.2f s", o->times[i]);
+            snprintf(path, sizeof path, "%s/time_%08.3f.png", jb->out, o->times[i]);
+        } else {
+            snprintf(what, sizeof what, "frame %ld", o->frames[i]);
+            snprintf(path, sizeof path, "%s/frame_%05ld.png", jb->out, o->frames[i]);
+        }
+        snprintf(text, sizeof text, "%s%s%s  %s", o->caption ? o->caption : "", o->caption ? "  " : "", what,
+                 ex_method_name(jb->method));
         caption(&jb->img, text);
-        snprintf(path, sizeof path, "%s/frame_%05ld.png", jb->out, o->frames[i]);
-        if (emit(jb->s, &jb->img, path, o->frames[i], ex_method_name(jb->method), 1e3 * (ex_now() - t0),
-                 jb->sc.last_apply_ms, jb->err, jb->err_size) < 0)
+        if (emit(jb->s, &jb->img, path, o->times ? -1 : o->frames[i], o->times ? o->times[i] : -1.0,
+                 ex_method_name(jb->method), 1e3 * (ex_now() - t0), jb->sc.last_apply_ms, jb->err, jb->err_size) < 0)
             return -1;
     }
     return 0;
@@ -384,7 +406,7 @@ static int render_turntable(job *jb, int n, int folder)
             snprintf(path, sizeof path, "%s/turn_%03d.png", jb->out, i);
         else
             snprintf(path, sizeof path, "%s", jb->out);
-        if (emit(jb->s, &jb->img, path, -1, ex_method_name(jb->method), 1e3 * (ex_now() - t0), jb->sc.last_apply_ms,
+        if (emit(jb->s, &jb->img, path, -1, -1.0, ex_method_name(jb->method), 1e3 * (ex_now() - t0), jb->sc.last_apply_ms,
                  jb->err, jb->err_size) < 0)
             return -1;
     }
@@ -415,7 +437,7 @@ static int run(const ex_render_options *o, summary *s, char *err, size_t err_siz
         goto done;
     }
     int frames = jb.motion && !o->compare, folder = frames || o->turntable;
-    s->total = frames ? (int)o->frame_count : o->turntable ? o->turntable : 1;
+    s->total = frames ? (int)pick_count(o) : o->turntable ? o->turntable : 1;
     s->start = ex_now();
     jb.out = o->output ? o->output : folder ? "render" : "pose.png";
     if (folder && make_dir(jb.out, err, err_size) < 0)
@@ -443,6 +465,7 @@ int main(int argc, char **argv)
         if (parsed < 0)
             fprintf(stderr, "pose-render: %s\n", err);
         free(o.frames);
+        free(o.times);
         return parsed < 0 ? 2 : 0;
     }
     summary s = {.json = o.json ? stdout : NULL, .first = 1};
@@ -466,6 +489,7 @@ int main(int argc, char **argv)
         fprintf(s.json, "\n}\n");
     }
     free(o.frames);
+    free(o.times);
     if (rc != 0) {
         fprintf(stderr, "pose-render: %s\n", err);
         return 1;

@@ -365,6 +365,68 @@ static void test_silhouette_follows_replay(void **state)
         free(im[i].px);
 }
 
+/* Device recordings picked by recorded time (--times): the HID mannequin's and
+ * the CAN rig's right leg drive the bar from seated (hip and knee bent) to
+ * standing; the bridge replays each recording as fast as possible up to the
+ * time asked for. */
+static void test_silhouette_follows_recordings(void **state)
+{
+    (void)state;
+    char log[2400], maps[2048];
+    snprintf(log, sizeof log, "%s/recordings.log", tmp);
+    assert_int_equal(run(log, "'%s' --help", render_bin), 0);
+    if (strstr(slurp(log), "built without the bridge"))
+        skip();
+    const char *data = getenv("POSE_DATA_DIR");
+    assert_non_null(data);
+    snprintf(maps, sizeof maps, "%s", bar_map); /* bar_map's siblings in bridge/maps/ */
+    char *slash = strrchr(maps, '/');
+    assert_non_null(slash);
+    *slash = '\0';
+    static const struct {
+        const char *source, *map, *times;
+        double t[2];
+    } rec[2] = {
+        {"hid/mannequin_sit_to_stand.hid", "hid_mannequin_bar.json", "0.5,6", {0.5, 6.0}}, /* 8 s long */
+        {"can-rig/sit_stand_arm_raise.log", "can_rig_bar.json", "0.5,4", {0.5, 4.0}},      /* 10 s long */
+    };
+    /* Invalid first: a time past the recording's end, and --frames on a recording. */
+    assert_int_equal(run(log, "'%s' '%s' --source '%s/%s' --map '%s/%s' --times 0,60 -o '%s/rec_bad'", render_bin,
+                         bar, data, rec[0].source, maps, rec[0].map, tmp),
+                     1);
+    assert_non_null(strstr(slurp(log), "past the end of the recording"));
+    assert_int_equal(run(log, "'%s' '%s' --source '%s/%s' --map '%s/%s' --frames 0 -o '%s/rec_bad'", render_bin, bar,
+                         data, rec[1].source, maps, rec[1].map, tmp),
+                     1);
+    assert_non_null(strstr(slurp(log), "--times"));
+    for (int r = 0; r < 2; r++) {
+        char dir[2400];
+        snprintf(dir, sizeof dir, "%s/rec_%d", tmp, r);
+        assert_int_equal(run(log, "'%s' '%s' --source '%s/%s' --map '%s/%s' --times %s --size 240x240 -o '%s' --json",
+                             render_bin, bar, data, rec[r].source, maps, rec[r].map, rec[r].times, dir),
+                         0);
+        char stamp[64];
+        snprintf(stamp, sizeof stamp, "\"time_s\": %g,", rec[r].t[1]);
+        assert_non_null(strstr(slurp(log), stamp));
+        image im[2];
+        for (int i = 0; i < 2; i++) {
+            char png[2500];
+            snprintf(png, sizeof png, "%s/time_%08.3f.png", dir, rec[r].t[i]);
+            im[i] = load_png(png);
+            assert_true(coverage(&im[i]) > 0.01);
+        }
+        size_t diff = 0;
+        for (size_t y = 0; y < im[0].h; y++)
+            for (size_t x = 0; x < im[0].w; x++)
+                diff += (size_t)(is_fg(&im[0], x, y) != is_fg(&im[1], x, y));
+        printf("%s: silhouette pixels changed from %.1f s to %.1f s: %zu\n", rec[r].source, rec[r].t[0], rec[r].t[1],
+               diff);
+        assert_true(diff > 300); /* seated (hip and knee bent 90 degrees) against standing */
+        for (int i = 0; i < 2; i++)
+            free(im[i].px);
+    }
+}
+
 /*
  * Candy wrapper: a 135 degree twist of the bar about its axis makes LBS
  * collapse the cross-section at the joint; CoR keeps it. Seen from the side,
@@ -545,6 +607,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_rest_image_not_blank),
         cmocka_unit_test(test_silhouette_follows_pose),
         cmocka_unit_test(test_silhouette_follows_replay),
+        cmocka_unit_test(test_silhouette_follows_recordings),
         cmocka_unit_test(test_lbs_vs_cor_twist),
         cmocka_unit_test(test_compare_panel),
         cmocka_unit_test(test_turntable),
