@@ -9,6 +9,9 @@
 #   4. replays a bundled CMU walk (data/mocap/cmu-bvh/131_01.bvh) onto it
 #      through the input bridge (pose-bridge)
 #   5. renders frames to PNG (pose-render, off-screen) into out/demo/
+#   6. renders the recorded devices of the same demo (a HID mannequin's
+#      hid-recorder file, a CAN goniometer rig's candump log) at a few
+#      recorded times into out/demo/hid/ and out/demo/can/
 # With --view and a display, it then opens pose-view on the same rig and clip.
 # Where a stage is missing from this checkout, the script says so and shows
 # the same chain on the synthetic bar instead; it never pretends.
@@ -28,7 +31,8 @@ usage() {
     cat <<EOF
 usage: bash scripts/demo.sh [--view] [--no-deps] [--out DIR] [--build DIR] [--jobs N]
 Install dependencies, build, bake the bundled anatomy, replay a CMU walk
-onto it and render PNG frames (headless). Results go to out/demo/.
+onto it and render PNG frames (headless), then frames of a HID mannequin
+recording and a CAN rig log. Results go to out/demo/.
   --view      afterwards open pose-view on the result (needs \$DISPLAY)
   --no-deps   skip scripts/install-deps.sh (packages already present)
   --out DIR   where to write the rig, images and logs (default out/demo)
@@ -69,7 +73,7 @@ mkdir -p "$out"
 log="$out/demo.log"
 : >"$log"
 
-stage "1/5 dependencies"
+stage "1/6 dependencies"
 if [ $deps -eq 1 ]; then
     if [ "$(id -u)" -eq 0 ]; then
         bash "$root/scripts/install-deps.sh"
@@ -82,7 +86,7 @@ else
     echo "skipped (--no-deps)"
 fi
 
-stage "2/5 build (Release, $build)"
+stage "2/6 build (Release, $build)"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >>"$log" 2>&1 ||
     die "cmake configure failed; see $log"
 # Only what the demo runs: the test suite is scripts/test.sh's job.
@@ -104,7 +108,9 @@ synth=$(tool pose-synth)
 pose_view=$(tool pose-view)
 
 frames_dir="$out/frames"
-rm -rf "$frames_dir"
+hid_dir="$out/hid"
+can_dir="$out/can"
+rm -rf "$frames_dir" "$hid_dir" "$can_dir"
 mkdir -p "$frames_dir"
 
 # The full chain needs pose-bake and the bridge's replay; both are detected, not assumed.
@@ -118,7 +124,7 @@ grep -q "built without the bridge" <<<"$help" || have_source=1
 
 bake_failed=0
 if [ $have_bake -eq 1 ]; then
-    stage "3/5 bake the bundled anatomy (reduced resolution)"
+    stage "3/6 bake the bundled anatomy (reduced resolution)"
     rig="$out/body.rig"
     # BAKE_ARGS: the reduced resolution (the default is finer and slower).
     # shellcheck disable=SC2086 # BAKE_ARGS holds several options
@@ -134,7 +140,7 @@ if [ $have_bake -eq 1 ]; then
 fi
 if [ $have_bake -eq 0 ] || [ $bake_failed -eq 1 ]; then
     [ $have_bake -eq 0 ] &&
-        stage "3/5 bake: pose-bake is not in this build - using the synthetic four-bone bar instead"
+        stage "3/6 bake: pose-bake is not in this build - using the synthetic four-bone bar instead"
     [ -n "$synth" ] || die "neither pose-bake nor pose-synth was built; see $log"
     rig="$out/bar.rig"
     "$synth" bar -o "$rig" | tee -a "$log"
@@ -157,7 +163,7 @@ else
 fi
 
 if [ $have_source -eq 1 ] && [ -n "$map" ] && [ -f "$map" ]; then
-    stage "4/5 replay $(basename "$clip") (CMU walk) onto the $kind through the bridge, mapping $(basename "$map")"
+    stage "4/6 replay $(basename "$clip") (CMU walk) onto the $kind through the bridge, mapping $(basename "$map")"
     if [ $have_replay -eq 1 ]; then
         # Real time (x1) for the first 4 s: the bridge thread publishes, a 60 Hz host loop applies.
         echo "pose-bridge replay, first 4 s in real time:"
@@ -169,14 +175,14 @@ if [ $have_source -eq 1 ] && [ -n "$map" ] && [ -f "$map" ]; then
         echo "(pose-bridge replay is not in this build yet: the frames below are decoded, retargeted"
         echo " and applied by the bridge library linked into pose-render)"
     fi
-    stage "5/5 render frames (OSMesa, off-screen)"
+    stage "5/6 render frames (OSMesa, off-screen)"
     "$render" "$rig" --source "$clip" --map "$map" --frames 1-961:60 --fit follow --caption "CMU 131_01 walk" \
         "${panel[@]}" -o "$frames_dir" | tee -a "$log"
     "$render" "$rig" --compare --source "$clip" --map "$map" --frames 481 --caption "walk frame 481" \
         "${panel[@]}" -o "$out/compare_walk.png" | tee -a "$log"
 else
-    stage "4/5 replay: this build has no bridge - posing joint $joint by hand instead"
-    stage "5/5 render frames (OSMesa, off-screen)"
+    stage "4/6 replay: this build has no bridge - posing joint $joint by hand instead"
+    stage "5/6 render frames (OSMesa, off-screen)"
     for a in 0 30 60 90; do
         "$render" "$rig" --pose "$joint=0,$a,0" --caption "bend $a deg" \
             -o "$frames_dir/bend_$(printf %03d "$a").png" | tee -a "$log"
@@ -191,6 +197,32 @@ if [ -n "$export_tool" ]; then
         --weights "$joint" | tee -a "$log"
 fi
 
+# The recorded devices (data/hid, data/can-rig): each recording replays as fast as
+# possible through the bridge's own decoder (HID report descriptor, DBC) and the
+# mapping, up to each time asked for; the image shows the pose held at that time.
+hid_rec="$root/data/hid/mannequin_sit_to_stand.hid"
+can_rec="$root/data/can-rig/sit_stand_arm_raise.log"
+if [ $have_source -eq 0 ]; then
+    stage "6/6 device recordings: this build has no bridge - skipped"
+else
+    if [ "$kind" = body ]; then
+        hid_map="$root/bridge/maps/hid_mannequin_full_body.json"
+        can_map="$root/bridge/maps/can_rig_fullbody.json"
+        what="the body"
+    else # the bar carries the right leg (hip, knee, ankle) of either device
+        hid_map="$root/bridge/maps/hid_mannequin_bar.json"
+        can_map="$root/bridge/maps/can_rig_bar.json"
+        what="the bar (right leg only)"
+    fi
+    stage "6/6 device recordings onto $what: HID mannequin $(basename "$hid_rec"), CAN rig $(basename "$can_rec")"
+    # Seen from the front-right, so hip and knee flexion show; one camera for all times of a recording.
+    look=(--azimuth 50 --elevation 10 "${panel[@]}")
+    "$render" "$rig" --source "$hid_rec" --map "$hid_map" --times 0.5,2.5,4,7 \
+        --caption "HID mannequin sit-to-stand" "${look[@]}" -o "$hid_dir" | tee -a "$log"
+    "$render" "$rig" --source "$can_rec" --map "$can_map" --times 0.5,2.2,4,7 \
+        --caption "CAN rig sit, stand, arms up" "${look[@]}" -o "$can_dir" | tee -a "$log"
+fi
+
 now=$(date +%s)
 printf '   (%ds)\n' $((now - stage_t))
 echo
@@ -201,6 +233,9 @@ else
 fi
 find "$out" -maxdepth 1 -type f | sort | sed "s|^$out/|  |"
 echo "  frames/: $(find "$frames_dir" -name '*.png' | wc -l) PNG images"
+for d in "$hid_dir" "$can_dir"; do
+    if [ -d "$d" ]; then echo "  $(basename "$d")/: $(find "$d" -name '*.png' | wc -l) PNG images"; fi
+done
 
 if [ $view -eq 1 ]; then
     if [ -z "${DISPLAY:-}${WAYLAND_DISPLAY:-}" ]; then
