@@ -131,13 +131,15 @@ int ex_parse_times(const char *opt, const char *s, double **times, size_t *count
         p = end;
         if (*p == '-') {
             last = strtod(p + 1, &end);
-            if (end == p + 1 || !isfinite(last) || last < first || *end != ':')
-                goto bad;
-            p = end + 1;
-            step = strtod(p, &end);
-            if (end == p || !isfinite(step) || step <= 0.0)
+            if (end == p + 1 || !isfinite(last) || last < first)
                 goto bad;
             p = end;
+            if (*p == ':') { /* else every second */
+                step = strtod(p + 1, &end);
+                if (end == p + 1 || !isfinite(step) || step <= 0.0)
+                    goto bad;
+                p = end;
+            }
         }
         double n = floor((last - first) / step + 1e-9) + 1.0; /* 0-5:0.5 takes 5 despite rounding */
         if (n + (double)*count > 100000.0) {
@@ -163,7 +165,8 @@ int ex_parse_times(const char *opt, const char *s, double **times, size_t *count
         p++;
     }
 bad:
-    snprintf(err, err_size, "%s: expected seconds as 0,2.5,5 or 0-10:0.5 (first-last:step), got '%s'", opt, s);
+    snprintf(err, err_size, "%s: expected seconds as 0,2.5,5 or 0-10:0.5 (first-last:step; step 1 s by default), "
+                            "got '%s'", opt, s);
 fail:
     free(*times);
     *times = NULL;

@@ -11,7 +11,7 @@
 /** "0,30,60" or "0-90:10" (first-last:step) into a new array of frame numbers. */
 int ex_parse_frames(const char *opt, const char *s, long **frames, size_t *count, char *err, size_t err_size);
 
-/** Seconds, "0,2.5,5" or "0-10:0.5" (first-last:step), into a new array. */
+/** Seconds, "0,2.5,5" or "0-10:0.5" (first-last:step, step 1 by default), into a new array. */
 int ex_parse_times(const char *opt, const char *s, double **times, size_t *count, char *err, size_t err_size);
 
 /** "800x600" with each side in [16, 8192]. */

@@ -9,6 +9,7 @@
  */
 #include "ex_motion.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -263,9 +264,13 @@ int ex_motion_set_frame(ex_motion *m, pose_state *st, long frame, char *err, siz
 int ex_motion_set_time(ex_motion *m, pose_state *st, double t_s, char *err, size_t err_size)
 {
     if (m->clip) {
-        long f = (long)(t_s / m->clip->frame_time + 1e-9);
-        return ex_motion_set_frame(m, st, f < (long)m->clip->frame_count ? f : (long)m->clip->frame_count, err,
-                                   err_size);
+        double f = floor(t_s / m->clip->frame_time + 1e-9);
+        if (f >= (double)m->clip->frame_count) {
+            snprintf(err, err_size, "%s: %.3f s is past the end of the clip (%.3f s)", m->name, t_s,
+                     (double)(m->clip->frame_count - 1) * m->clip->frame_time);
+            return -1;
+        }
+        return ex_motion_set_frame(m, st, (long)f, err, err_size);
     }
     if (!ends_with(m->spec, ".hid") && !ends_with(m->spec, ".log")) {
         snprintf(err, err_size, "%s: a live device has no recorded time to pick; play it live (pose-view)", m->name);
