@@ -19,6 +19,7 @@
 #include "mapping.h"
 #include "rig_skel.h"
 #include "runner.h"
+#include "runner_poll.h"
 
 static const char *const BODY[][2] = {
     {"pelvis", ""}, {"lumbar", "pelvis"}, {"thorax", "lumbar"}, {"neck", "thorax"}, {"head", "neck"},
@@ -63,15 +64,7 @@ static void test_runner_replay(void **state)
     if (pb_runner_start_source(src, skel, map, &opt, &run, &err) != POSE_OK)
         fail_msg("%s", err.message);
     /* host frames while it plays: poses come, never blocking */
-    int fresh_seen = 0;
-    for (int i = 0; i < 20; i++) {
-        int fresh = 0;
-        const pb_pose *p = pb_runner_latest(run, &fresh);
-        fresh_seen += fresh && p->seq > 0;
-        struct timespec ts = {0, 10000000};
-        nanosleep(&ts, NULL);
-    }
-    assert_true(fresh_seen > 5);
+    assert_true(runner_poll_fresh(run, 20) > 5);
     assert_int_equal(pb_runner_wait(run, 10000), 1); /* 10 s of log at 20x: 0.5 s */
     pb_runner_stats st;
     pb_runner_stats_get(run, &st);

@@ -20,6 +20,7 @@
 #include "mapping.h"
 #include "rig_skel.h"
 #include "runner.h"
+#include "runner_poll.h"
 
 /* Rotation about y by deg: {0, sin(deg/2), 0, cos(deg/2)}. */
 static void assert_about_y(const float q[4], double deg, double tol)
@@ -49,15 +50,7 @@ static void test_runner_hid_replay(void **state)
     pb_runner_options opt = {.speed = 1};
     if (pb_runner_start_source(src, skel, map, &opt, &run, &err) != POSE_OK)
         fail_msg("%s", err.message);
-    int fresh_seen = 0;
-    for (int i = 0; i < 20; i++) {
-        int fresh = 0;
-        const pb_pose *p = pb_runner_latest(run, &fresh);
-        fresh_seen += fresh && p->seq > 0;
-        struct timespec ts = {0, 10000000};
-        nanosleep(&ts, NULL);
-    }
-    assert_true(fresh_seen > 5);
+    assert_true(runner_poll_fresh(run, 20) > 5);
     assert_int_equal(pb_runner_wait(run, 20000), 1); /* 8 s of recording at 8x: 1 s */
     pb_runner_stats st;
     pb_runner_stats_get(run, &st);
