@@ -1,13 +1,14 @@
 # SPDX-License-Identifier: Apache-2.0
 # HID backend link dependencies (included by bridge/CMakeLists.txt after the
-# pose_bridge target exists). hidapi's hidraw backend (BSD/GPL/original
+# bridge targets exist). hidapi's hidraw backend (BSD/GPL/original
 # hidapi licence, used under its permissive terms) is optional: without it the
 # recordings, the decoder and the simulated devices still build; live devices
 # report POSE_ERR_UNSUPPORTED.
 pkg_check_modules(HIDAPI IMPORTED_TARGET hidapi-hidraw)
 if(HIDAPI_FOUND)
-  target_link_libraries(pose_bridge PUBLIC PkgConfig::HIDAPI)
-  target_compile_definitions(pose_bridge PRIVATE POSE_BRIDGE_HAVE_HIDAPI=1)
+  pose_bridge_link(PkgConfig::HIDAPI)
+  pose_bridge_define(POSE_BRIDGE_HAVE_HIDAPI=1)
+  set(POSE_BRIDGE_HAVE_HIDAPI ON PARENT_SCOPE)
 else()
   message(STATUS "pose-bridge: hidapi-hidraw not found; live HID devices disabled (recordings still work)")
 endif()
@@ -15,7 +16,7 @@ endif()
 
 # Generator of the reference mannequin recordings in data/hid/ (reproducible).
 add_executable(pose-hid-mannequin-gen "${CMAKE_CURRENT_SOURCE_DIR}/devices/mannequin_gen.c")
-target_link_libraries(pose-hid-mannequin-gen PRIVATE pose_bridge)
+target_link_libraries(pose-hid-mannequin-gen PRIVATE pose_bridge_internal)
 target_compile_definitions(pose-hid-mannequin-gen PRIVATE _POSIX_C_SOURCE=200809L)
 pose_target_warnings(pose-hid-mannequin-gen)
 

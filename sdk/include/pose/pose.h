@@ -244,6 +244,81 @@ POSE_API pose_status pose_rig_tet_info(const pose_rig *rig, pose_tet_info *out);
 /** Free-form provenance text stored in the rig ("" when none); owned by the rig. @since 0.1 */
 POSE_API const char *pose_rig_metadata(const pose_rig *rig);
 
+/* ----------------------------------------------------- clinical angles */
+
+/**
+ * Clinical joint angles (design §2b): degrees from the anatomical neutral
+ * posture (standing upright, arms hanging at the sides, palms to the
+ * thighs), named as clinicians and goniometers name them:
+ *
+ *   deg[0]  flexion (+) / extension (-), about the medio-lateral axis
+ *           (plantar flexion (-) / dorsiflexion (+) at the ankle);
+ *   deg[1]  abduction (+) / adduction (-), about the floating antero-posterior
+ *           axis (lateral bending for the spine, radial deviation (+) / ulnar
+ *           deviation (-) at the wrist, varus (+) / valgus (-) at elbow and knee);
+ *   deg[2]  internal (+) / external (-) rotation about the distal segment's
+ *           long axis (pronation (+) / supination (-) of the forearm, axial
+ *           rotation of the spine).
+ *
+ * pose_joint_clinical.names says what positive means for each joint. The
+ * three compose as the ISB joint coordinate systems do (Wu et al., J Biomech
+ * 2002, 2005): flexion about the proximal segment's axis, then abduction
+ * about the floating axis, then rotation about the distal segment's axis,
+ * each axis taken in the neutral posture and expressed in the joint's rest
+ * frame:
+ *
+ *   local = R(axes[0], deg[0]) * R(axes[1], deg[1]) * R(axes[2], deg[2]) * neutral
+ *
+ * (`local` as in pose_set_joint: relative to the joint's rest frame.) All
+ * zero is the neutral posture, whatever pose the rig rests in; on the bundled
+ * body, shoulder flexion 90 points the arm forward, 150 puts the hand above
+ * the head, and shoulder abduction 90 is the T-pose the body was scanned in.
+ *
+ * Rotations compose; angles are never added axis by axis. Where a rig carries
+ * clinical data for a joint, that joint's limits are the clinical ones
+ * (AAOS normal ranges of motion by default) and every way of setting it
+ * (pose_set_joint, pose_set_joint_euler, pose_set_joint_clinical) is clamped
+ * in the clinical convention.
+ */
+typedef struct pose_joint_clinical {
+    float neutral[4];      /**< local rotation (relative to rest) of the neutral posture */
+    float axes[3][3];      /**< flexion, abduction, rotation axes: unit, orthogonal, in the rest frame */
+    const char *names[3];  /**< what positive means per angle ("flexion", "abduction",
+                                "internal_rotation", "pronation" ...); owned by the rig
+                                (in a pose_rig_desc: 1..31 bytes each, or NULL for the defaults) */
+    uint32_t limit_flags;  /**< POSE_LIMIT_X / _Y / _Z: deg[0] / deg[1] / deg[2] limited */
+    float limit_min_deg[3];/**< clinical range of motion */
+    float limit_max_deg[3];
+    uint32_t flags;        /**< POSE_CLINICAL_*; 0 in a desc entry = the joint has no clinical data */
+} pose_joint_clinical;
+
+/** pose_joint_clinical.flags */
+enum {
+    /** The joint has clinical data (neutral, axes, limits). */
+    POSE_CLINICAL_DEFINED = 1u << 0,
+};
+
+/**
+ * The neutral posture and clinical axes of `joint`. POSE_ERR_UNSUPPORTED when
+ * the rig has none for it (rigs written before format 1.1, joints such as the
+ * root that have no clinical angles). @since 0.2
+ */
+POSE_API pose_status pose_rig_joint_clinical(const pose_rig *rig, int joint, pose_joint_clinical *out);
+/** Clinical angles {flexion, abduction, rotation} (degrees) -> local rotation; no limits applied. @since 0.2 */
+POSE_API pose_status pose_clinical_to_local(const pose_rig *rig, int joint, const float deg[3], float quat_xyzw[4]);
+/**
+ * Local rotation -> clinical angles. Two angle triples give every rotation
+ * (abduction a and 180 - a); the one nearest `hint_deg` is returned (NULL:
+ * the one inside the joint's limits, else abduction in [-90, 90]). @since 0.2
+ */
+POSE_API pose_status pose_local_to_clinical(const pose_rig *rig, int joint, const float quat_xyzw[4],
+                                            const float hint_deg[3], float deg[3]);
+
+/** Unit quaternion {x,y,z,w} from Euler angles {x,y,z} in degrees (the one implementation). @since 0.2 */
+POSE_API void pose_euler_to_quat(const float deg[3], pose_euler_order order, float quat_xyzw[4]);
+/** Euler angles {x,y,z} (degrees) of a unit quaternion, middle angle in [-90, 90]. @since 0.2 */
+POSE_API void pose_quat_to_euler(const float quat_xyzw[4], pose_euler_order order, float deg[3]);
+
 /* ------------------------------------------------------- building rigs */
 
 /** One joint of a rig description. */
@@ -288,6 +363,10 @@ typedef struct pose_rig_desc {
     size_t tissue_count;
     const pose_tissue_desc *tissues;
     const char *metadata;      /**< may be NULL */
+    /** Per joint (joint_count entries), or NULL: the rig then knows no neutral
+     *  posture and no clinical axes (pose_rig_joint_clinical says
+     *  POSE_ERR_UNSUPPORTED). Stored in the optional `clinical` section. @since 0.2 */
+    const struct pose_joint_clinical *clinical;
 } pose_rig_desc;
 
 /**
@@ -335,6 +414,17 @@ POSE_API pose_status pose_set_joint(pose_state *state, int joint, const float qu
 /** Set a joint's local rotation from Euler angles {x,y,z} in degrees. @since 0.1 */
 POSE_API pose_status pose_set_joint_euler(pose_state *state, int joint, const float deg[3],
                                           pose_euler_order order);
+/**
+ * Set a joint from clinical angles {flexion, abduction, rotation} in degrees
+ * from the neutral posture (see pose_joint_clinical). POSE_CLAMPED when the
+ * joint's clinical range of motion changed them; POSE_ERR_UNSUPPORTED when
+ * the rig has no clinical data for the joint. @since 0.2
+ */
+POSE_API pose_status pose_set_joint_clinical(pose_state *state, int joint, const float deg[3]);
+/** The joint's current clinical angles (the triple nearest the last request). @since 0.2 */
+POSE_API pose_status pose_get_joint_clinical(const pose_state *state, int joint, float deg[3]);
+/** Every joint with clinical data to its neutral posture (the others to rest), root to identity. @since 0.2 */
+POSE_API pose_status pose_set_neutral(pose_state *state);
 /** The joint's current local rotation (after clamping). @since 0.1 */
 POSE_API pose_status pose_get_joint(const pose_state *state, int joint, float quat_xyzw[4]);
 /**
