@@ -39,6 +39,11 @@ const char *pose_last_error(void)
     return error_message;
 }
 
+void pose_set_last_error(const char *message)
+{
+    pose__set_error("%s", message ? message : "");
+}
+
 const char *pose_status_string(pose_status status)
 {
     switch (status) {

@@ -98,6 +98,12 @@ POSE_API const char *pose_status_string(pose_status status);
  * @since 0.1
  */
 POSE_API const char *pose_last_error(void);
+/**
+ * Set the message pose_last_error() returns on this thread (plain text, not
+ * a format). For libraries layered on libpose, such as libpose_bridge, so a
+ * host reads one error channel. @since 0.2
+ */
+POSE_API void pose_set_last_error(const char *message);
 
 /* ----------------------------------------------------------------- values */
 
