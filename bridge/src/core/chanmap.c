@@ -1,9 +1,12 @@
 /* SPDX-License-Identifier: Apache-2.0
- * Scalar channels (HID axes, CAN signals) -> joint Euler angles.
+ * Scalar channels (HID axes, CAN signals) -> joint rotations.
  * Per entry, in this order: calibration (two-point or offset/scale) to
  * degrees, inversion, One Euro filter, deadband (hold the output until the
- * value moves more than the band away from it), joint limits. Entries of one
- * joint are combined as Euler angles in that joint's order. */
+ * value moves more than the band away from it), limits. The entries of one
+ * joint then compose as rotations: clinical angles ("dof") about the joint's
+ * anatomical axes onto its neutral offset (pose.h, pose_joint_clinical), or
+ * rest-frame Euler angles ("axis") in the joint's order. Never by adding
+ * angles of different joints' frames. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -26,6 +29,7 @@ struct pb_chanmap {
     int joint_count;
     int *joint_entries; /* per rig joint: number of entries driving it */
     pose_euler_order *joint_order;
+    const pb_rig_skel *rig; /* clinical axes and neutral offsets; outlives the chanmap */
 };
 
 void pb_chanmap_free(pb_chanmap *c)
@@ -70,6 +74,28 @@ static long find_by_usage(const pb_channel *ch, size_t n, uint32_t usage, int in
     return -1;
 }
 
+/* The clinical angle an entry's "dof" names: the generic names, or the
+ * rig's own name for one of the joint's three angles. */
+static int resolve_dof(const pb_mapping *map, int i, const pb_rig_joint *J, pb_map_channel *m, pb_error *err)
+{
+    static const char *const generic[3] = {"flexion", "abduction", "rotation"};
+    if (!(J->clinical.flags & POSE_CLINICAL_DEFINED)) {
+        pb_fail(err, POSE_ERR_NOT_FOUND,
+                "%s: channels[%d].dof: the rig has no neutral posture or clinical axes for joint %s (bake it "
+                "from a template with \"clinical\" joints, or map rest-frame Euler angles with \"axis\")",
+                map->path, i, J->name);
+        return -1;
+    }
+    for (int k = 0; k < 3; k++)
+        if (!strcmp(m->dof, generic[k]) || !strcmp(m->dof, J->clinical_names[k])) {
+            m->axis = k; /* from here on: the index of the clinical angle */
+            return 0;
+        }
+    pb_fail(err, POSE_ERR_NOT_FOUND, "%s: channels[%d].dof: joint %s has no angle '%s' (it has %s, %s, %s)",
+            map->path, i, J->name, m->dof, J->clinical_names[0], J->clinical_names[1], J->clinical_names[2]);
+    return -1;
+}
+
 pose_status pb_chanmap_create(const pb_mapping *map, const pb_channel *channels, size_t channel_count,
                               const pb_rig_skel *rig, pb_chanmap **out, pb_error *err)
 {
@@ -83,6 +109,7 @@ pose_status pb_chanmap_create(const pb_mapping *map, const pb_channel *channels,
         return pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "out of memory");
     c->count = map->channel_count;
     c->joint_count = rig->joint_count;
+    c->rig = rig;
     c->e = calloc((size_t)c->count, sizeof *c->e);
     c->joint_entries = calloc((size_t)(rig->joint_count > 0 ? rig->joint_count : 1), sizeof *c->joint_entries);
     c->joint_order = calloc((size_t)(rig->joint_count > 0 ? rig->joint_count : 1), sizeof *c->joint_order);
@@ -91,7 +118,7 @@ pose_status pb_chanmap_create(const pb_mapping *map, const pb_channel *channels,
         return pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "out of memory");
     }
     for (int i = 0; i < c->count; i++) {
-        chan_state *E = &c->e[i];
+            chan_state *E = &c->e[i];
         E->m = map->channels[i];
         long ch;
         if (E->m.channel[0]) {
@@ -120,7 +147,19 @@ pose_status pb_chanmap_create(const pb_mapping *map, const pb_channel *channels,
             return pb_fail(err, POSE_ERR_NOT_FOUND, "%s: channels[%d].joint: the rig has no joint '%s'", map->path, i,
                            map->channels[i].joint);
         }
-        if (c->joint_entries[E->joint]++ && c->joint_order[E->joint] != E->m.order) {
+        if (E->m.axis < 0 && resolve_dof(map, i, &rig->joints[E->joint], &E->m, err) < 0) {
+            pb_chanmap_free(c);
+            return POSE_ERR_NOT_FOUND;
+        }
+        /* One joint's entries are all clinical or all rest-frame Euler: the two do not compose. */
+        for (int k = 0; k < i; k++)
+            if (c->e[k].joint == E->joint && (c->e[k].m.axis < 0) != (E->m.axis < 0)) {
+                pb_chanmap_free(c);
+                return pb_fail(err, POSE_ERR_INVALID_DATA,
+                               "%s: channels[%d]: joint %s mixes \"dof\" and \"axis\" entries", map->path, i,
+                               map->channels[i].joint);
+            }
+        if (c->joint_entries[E->joint]++ && E->m.axis >= 0 && c->joint_order[E->joint] != E->m.order) {
             pb_chanmap_free(c);
             return pb_fail(err, POSE_ERR_INVALID_DATA, "%s: channels[%d].order: joint %s already uses another order",
                            map->path, i, map->channels[i].joint);
@@ -160,6 +199,26 @@ double pb_chanmap_value(const pb_chanmap *c, int entry)
     return entry >= 0 && entry < c->count ? c->e[entry].out : 0.0;
 }
 
+/* local = R(axes[0], flexion) R(axes[1], abduction) R(axes[2], rotation) * neutral
+ * (pose.h, pose_joint_clinical; libpose's pose_clinical_to_local is the same map). */
+static void clinical_to_local(const pose_joint_clinical *cl, const double deg[3], double q[4])
+{
+    double acc[4], r[4], t[4];
+    for (int k = 0; k < 4; k++)
+        acc[k] = cl->neutral[k];
+    for (int a = 2; a >= 0; a--) {
+        double h = deg[a] * (PB_PI / 360.0), sh = sin(h);
+        r[0] = cl->axes[a][0] * sh;
+        r[1] = cl->axes[a][1] * sh;
+        r[2] = cl->axes[a][2] * sh;
+        r[3] = cos(h);
+        pb_quat_mul(r, acc, t);
+        pb_quat_copy(acc, t);
+    }
+    pb_quat_normalize(acc);
+    pb_quat_copy(q, acc);
+}
+
 void pb_chanmap_pose(const pb_chanmap *c, pb_pose *out)
 {
     int n = out->joint_count < c->joint_count ? out->joint_count : c->joint_count;
@@ -167,10 +226,16 @@ void pb_chanmap_pose(const pb_chanmap *c, pb_pose *out)
         if (!c->joint_entries[j])
             continue;
         double deg[3] = {0, 0, 0}, q[4];
+        int clinical = 0;
         for (int i = 0; i < c->count; i++)
-            if (c->e[i].joint == j)
+            if (c->e[i].joint == j) {
                 deg[c->e[i].m.axis] += c->e[i].out;
-        pb_quat_from_euler(deg, c->joint_order[j], q);
+                clinical = c->e[i].m.dof[0] != 0;
+            }
+        if (clinical)
+            clinical_to_local(&c->rig->joints[j].clinical, deg, q);
+        else
+            pb_quat_from_euler(deg, c->joint_order[j], q);
         for (int k = 0; k < 4; k++)
             out->q[j][k] = (float)q[k];
         out->active[j] = 1;

@@ -7,8 +7,15 @@
  *   "channels": scalar channels (HID, CAN) driving one joint axis each:
  *     [ { "channel": "<pb_channel.name>"  (or "usage": "0x00010030" with
  *         optional "index": n for the n-th channel of that HID usage),
- *         "joint": "<rig joint>", "axis": "x"|"y"|"z",
- *         "order": "XYZ" (Euler order of this joint's channels; default XYZ),
+ *         "joint": "<rig joint>",
+ *         "dof": "flexion" | "abduction" | "rotation"  (or the rig's own name
+ *             for that angle: "dorsiflexion", "pronation" ...): a clinical
+ *             angle, degrees from the anatomical neutral posture (pose.h,
+ *             pose_joint_clinical); the joint's clinical angles compose as
+ *             rotations about its anatomical axes, onto its neutral offset;
+ *         or "axis": "x"|"y"|"z" with "order": "XYZ": an Euler angle about
+ *             the joint's rest frame (rigs without clinical data, the root),
+ *             the joint's channels composing in that order;
  *         "calibration": {"raw": [r0, r1], "deg": [d0, d1]}   two-point, or
  *                        {"offset": o, "scale": s}            deg = (raw + o) * s,
  *         "invert": false, "deadband": 0.0 (deg, around the last output),
@@ -62,7 +69,8 @@ typedef struct pb_map_channel {
     uint32_t usage;            /**< HID (page << 16 | usage) when channel is "" */
     int usage_index;           /**< n-th channel with that usage */
     char joint[PB_NAME_MAX];
-    int axis;                  /**< 0 x, 1 y, 2 z */
+    int axis;                  /**< rest-frame Euler axis 0 x, 1 y, 2 z; -1: clinical, see dof */
+    char dof[32];              /**< clinical angle ("flexion", "abduction", "rotation" or the rig's name for it) */
     pose_euler_order order;
     pb_calib_kind calib;
     double raw[2], deg[2];     /**< two-point */

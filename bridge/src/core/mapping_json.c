@@ -254,10 +254,25 @@ static pose_status parse_channel(pb_mapping *m, const cJSON *e, int i, pb_error 
     if (copy_name(C->joint, cJSON_GetObjectItemCaseSensitive(e, "joint")))
         return pb_fail(err, POSE_ERR_FORMAT, "%s: channels[%d].joint: expected a rig joint name", m->path, i);
     const cJSON *ax = cJSON_GetObjectItemCaseSensitive(e, "axis");
-    if (!cJSON_IsString(ax) || strlen(ax->valuestring) != 1 || (ax->valuestring[0] | 0x20) < 'x' ||
-        (ax->valuestring[0] | 0x20) > 'z')
-        return pb_fail(err, POSE_ERR_FORMAT, "%s: channels[%d].axis: expected \"x\", \"y\" or \"z\"", m->path, i);
-    C->axis = (ax->valuestring[0] | 0x20) - 'x';
+    const cJSON *dof = cJSON_GetObjectItemCaseSensitive(e, "dof");
+    if (ax && dof)
+        return pb_fail(err, POSE_ERR_FORMAT, "%s: channels[%d]: \"axis\" and \"dof\" exclude each other", m->path, i);
+    if (dof) {
+        /* Clinical: resolved against the rig's names when bound (pb_chanmap_create). */
+        if (!cJSON_IsString(dof) || !dof->valuestring[0] || strlen(dof->valuestring) >= sizeof C->dof)
+            return pb_fail(err, POSE_ERR_FORMAT,
+                           "%s: channels[%d].dof: expected \"flexion\", \"abduction\", \"rotation\" or a name "
+                           "the rig gives the joint's angle", m->path, i);
+        snprintf(C->dof, sizeof C->dof, "%s", dof->valuestring);
+        C->axis = -1;
+    } else {
+        if (!cJSON_IsString(ax) || strlen(ax->valuestring) != 1 || (ax->valuestring[0] | 0x20) < 'x' ||
+            (ax->valuestring[0] | 0x20) > 'z')
+            return pb_fail(err, POSE_ERR_FORMAT,
+                           "%s: channels[%d]: expected \"dof\" (clinical angle) or \"axis\": \"x\", \"y\" or \"z\"",
+                           m->path, i);
+        C->axis = (ax->valuestring[0] | 0x20) - 'x';
+    }
     C->order = POSE_EULER_XYZ;
     const cJSON *od = cJSON_GetObjectItemCaseSensitive(e, "order");
     if (od && parse_order(od, &C->order))

@@ -22,6 +22,10 @@ typedef struct pb_rig_joint {
     double local_p[3];
     uint32_t limit_flags;  /**< POSE_LIMIT_* bits, as in pose_joint_desc (0: none known) */
     float limit_min_deg[3], limit_max_deg[3];
+    /** The rig's neutral posture and clinical axes (pose_joint_clinical), when
+     *  clinical.flags has POSE_CLINICAL_DEFINED; names copied into clinical_names. */
+    pose_joint_clinical clinical;
+    char clinical_names[3][32];
 } pb_rig_joint;
 
 typedef struct pb_rig_skel {
