@@ -36,30 +36,11 @@ static int cmp_double(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-static const char *const BODY[][2] = {
-    {"pelvis", ""}, {"lumbar", "pelvis"}, {"thorax", "lumbar"}, {"neck", "thorax"}, {"head", "neck"},
-    {"clavicle_r", "thorax"}, {"shoulder_r", "clavicle_r"}, {"elbow_r", "shoulder_r"}, {"wrist_r", "elbow_r"},
-    {"clavicle_l", "thorax"}, {"shoulder_l", "clavicle_l"}, {"elbow_l", "shoulder_l"}, {"wrist_l", "elbow_l"},
-    {"hip_r", "pelvis"}, {"knee_r", "hip_r"}, {"ankle_r", "knee_r"}, {"hip_l", "pelvis"}, {"knee_l", "hip_l"},
-    {"ankle_l", "knee_l"},
-};
-
 static pb_rig_skel *body_skel(void)
 {
-    enum { N = sizeof BODY / sizeof BODY[0] };
-    pose_joint_desc j[N];
-    memset(j, 0, sizeof j);
-    for (int i = 0; i < N; i++) {
-        j[i].name = BODY[i][0];
-        j[i].parent = -1;
-        for (int k = 0; k < i; k++)
-            if (strcmp(BODY[k][0], BODY[i][1]) == 0)
-                j[i].parent = k;
-        j[i].rest_model.rotation[3] = 1;
-    }
     pb_rig_skel *s = NULL;
     pb_error err;
-    if (pb_rig_skel_from_desc(j, N, &s, &err) != POSE_OK) {
+    if (pb_rig_skel_schematic_body(&s, &err) != POSE_OK) {
         fprintf(stderr, "bench_can: %s\n", err.message);
         exit(1);
     }

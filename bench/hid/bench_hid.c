@@ -32,7 +32,7 @@ static pb_rig_skel *body_skel(void)
 {
     pb_rig_skel *s;
     pb_error err;
-    if (pb_mannequin_body_skel(&s, &err) != POSE_OK)
+    if (pb_rig_skel_schematic_body(&s, &err) != POSE_OK)
         die("rig", &err);
     return s;
 }

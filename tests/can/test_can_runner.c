@@ -21,31 +21,12 @@
 #include "runner.h"
 #include "runner_poll.h"
 
-static const char *const BODY[][2] = {
-    {"pelvis", ""}, {"lumbar", "pelvis"}, {"thorax", "lumbar"}, {"neck", "thorax"}, {"head", "neck"},
-    {"clavicle_r", "thorax"}, {"shoulder_r", "clavicle_r"}, {"elbow_r", "shoulder_r"}, {"wrist_r", "elbow_r"},
-    {"clavicle_l", "thorax"}, {"shoulder_l", "clavicle_l"}, {"elbow_l", "shoulder_l"}, {"wrist_l", "elbow_l"},
-    {"hip_r", "pelvis"}, {"knee_r", "hip_r"}, {"ankle_r", "knee_r"}, {"hip_l", "pelvis"}, {"knee_l", "hip_l"},
-    {"ankle_l", "knee_l"},
-};
-
 static void test_runner_replay(void **state)
 {
     (void)state;
-    enum { N = sizeof BODY / sizeof BODY[0] };
-    pose_joint_desc j[N];
-    memset(j, 0, sizeof j);
-    for (int i = 0; i < N; i++) {
-        j[i].name = BODY[i][0];
-        j[i].parent = -1;
-        for (int k = 0; k < i; k++)
-            if (strcmp(BODY[k][0], BODY[i][1]) == 0)
-                j[i].parent = k;
-        j[i].rest_model.rotation[3] = 1;
-    }
     pb_rig_skel *skel = NULL;
     pb_error err;
-    assert_int_equal(pb_rig_skel_from_desc(j, N, &skel, &err), POSE_OK);
+    assert_int_equal(pb_rig_skel_schematic_body(&skel, &err), POSE_OK);
     char map_path[1024], log[1024];
     snprintf(map_path, sizeof map_path, "%s/../bridge/maps/can_rig_fullbody.json", getenv("POSE_DATA_DIR"));
     snprintf(log, sizeof log, "%s/can-rig/sit_stand_arm_raise.log", getenv("POSE_DATA_DIR"));

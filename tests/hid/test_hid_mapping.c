@@ -24,7 +24,7 @@ static pb_rig_skel *body_skel(void)
 {
     pb_rig_skel *s;
     pb_error err;
-    if (pb_mannequin_body_skel(&s, &err) != POSE_OK)
+    if (pb_rig_skel_schematic_body(&s, &err) != POSE_OK)
         fail_msg("%s", err.message);
     assert_int_equal(s->joint_count, 19);
     return s;

@@ -35,7 +35,7 @@ static void test_runner_hid_replay(void **state)
     (void)state;
     pb_rig_skel *skel = NULL;
     pb_error err;
-    assert_int_equal(pb_mannequin_body_skel(&skel, &err), POSE_OK);
+    assert_int_equal(pb_rig_skel_schematic_body(&skel, &err), POSE_OK);
     char map_path[1024], rec[1024];
     snprintf(map_path, sizeof map_path, "%s/../bridge/maps/hid_mannequin_full_body.json", getenv("POSE_DATA_DIR"));
     snprintf(rec, sizeof rec, "%s/hid/mannequin_sit_to_stand.hid", getenv("POSE_DATA_DIR"));

@@ -44,6 +44,14 @@ pose_status pb_rig_skel_from_rig(const pose_rig *rig, pb_rig_skel **out, pb_erro
 pose_status pb_rig_skel_from_clip(const pb_clip *clip, double scale, pb_rig_skel **out, pb_error *err);
 void pb_rig_skel_free(pb_rig_skel *s);
 /**
+ * The 19 joints of preprocess/templates/full_body.json (names and parents;
+ * rest frames identity, 0.1 apart along z) with schematic clinical data:
+ * neutral = rest, flexion about +-y, abduction about +-x, rotation about z,
+ * signed as the template's frames are. For tests and benchmarks of the
+ * full-body mappings that need no baked rig.
+ */
+pose_status pb_rig_skel_schematic_body(pb_rig_skel **out, pb_error *err);
+/**
  * The hinge axis of joint j read from its limits (0 x, 1 y, 2 z), or -1: the
  * joint is a hinge when, of its two axes other than `along` (the local axis
  * nearest its segment, which carries twist), one may turn by 60 degrees or

@@ -282,27 +282,3 @@ pose_status pb_mannequin_recording(pb_mannequin_motion m, double rate_hz, double
     *out = rec;
     return POSE_OK;
 }
-
-pose_status pb_mannequin_body_skel(pb_rig_skel **out, pb_error *err)
-{
-    static const char *const joints[][2] = {
-        {"pelvis", NULL},       {"lumbar", "pelvis"},     {"thorax", "lumbar"},        {"neck", "thorax"},
-        {"head", "neck"},       {"clavicle_r", "thorax"}, {"shoulder_r", "clavicle_r"}, {"elbow_r", "shoulder_r"},
-        {"wrist_r", "elbow_r"}, {"clavicle_l", "thorax"}, {"shoulder_l", "clavicle_l"}, {"elbow_l", "shoulder_l"},
-        {"wrist_l", "elbow_l"}, {"hip_r", "pelvis"},      {"knee_r", "hip_r"},         {"ankle_r", "knee_r"},
-        {"hip_l", "pelvis"},    {"knee_l", "hip_l"},      {"ankle_l", "knee_l"},
-    };
-    enum { N = sizeof joints / sizeof joints[0] };
-    pose_joint_desc j[N];
-    memset(j, 0, sizeof j);
-    for (int i = 0; i < N; i++) {
-        j[i].name = joints[i][0];
-        j[i].parent = -1;
-        for (int k = 0; k < i; k++)
-            if (joints[i][1] && strcmp(joints[k][0], joints[i][1]) == 0)
-                j[i].parent = k;
-        j[i].rest_model.rotation[3] = 1.0f;
-        j[i].rest_model.translation[2] = 0.1f * (float)i;
-    }
-    return pb_rig_skel_from_desc(j, N, out, err);
-}

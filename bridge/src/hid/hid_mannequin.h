@@ -68,12 +68,4 @@ void pb_mannequin_pack(const double deg[PB_MANNEQUIN_AXES], int hold, uint16_t s
 pose_status pb_mannequin_recording(pb_mannequin_motion m, double rate_hz, double seconds, uint32_t seed,
                                    pb_hid_recording **out, pb_error *err);
 
-/**
- * A skeleton with the 19 joints of preprocess/templates/full_body.json
- * (names and parents; rest frames identity, 0.1 apart along z): the rig the
- * mannequin's full-body mapping addresses, for tests and benchmarks that
- * need no baked rig. Free with pb_rig_skel_free.
- */
-pose_status pb_mannequin_body_skel(pb_rig_skel **out, pb_error *err);
-
 #endif /* POSE_BRIDGE_HID_MANNEQUIN_H */
