@@ -29,15 +29,19 @@
  *                               the .asf beside it (01_01.amc -> 01_01.asf, then 01.asf)
  *   path.hid                    hid-recorder file (simulated HID device)
  *   path.log                    candump -l log (simulated CAN bus)
- *   hid:VID:PID[:SERIAL]        live HID device (hex ids), through hidapi
+ *   hid:VID:PID[:PAGE:USAGE]    live HID device (hex USB ids; optionally the top-level
+ *                               collection's usage page and usage), through hidapi
  *   /dev/hidrawN                live HID device node
  *   can:IFACE  or  IFACE        live SocketCAN interface (can0, vcan0 ...)
  *   KIND:PATH                   a file of another extension: bvh:, amc:,
  *                               hid-recording:, candump:
  *
  * HID and CAN sources need a mapping with "channels" (and, for CAN, its "can"
- * bus description); clips map rig joints to clip joints of the same name
- * without one. Mappings speak the clinical angle convention of pose.h
+ * bus description, whose relative "dbc" path is taken from the mapping file's
+ * folder, or from the working directory for map_json); clips map rig joints
+ * to clip joints of the same name without one. Recorded times count from the
+ * recording's start (a hid-recorder file's times, a candump log's first
+ * frame); a live source's from its first sample. Mappings speak the clinical angle convention of pose.h
  * (pose_joint_clinical) where the rig knows its neutral posture: a device
  * reading 0 in the anatomical neutral posture puts the patient there.
  *
@@ -80,9 +84,15 @@ typedef enum pose_bridge_play {
     POSE_BRIDGE_MANUAL = 2,   /**< no thread: the host picks times with pose_bridge_pose_at */
 } pose_bridge_play;
 
-/** Options for pose_bridge_open; a zeroed struct (with size set) gives the defaults. */
+/**
+ * Options for pose_bridge_open; a zeroed struct (with size set) gives the
+ * defaults. `size` lets the struct grow: pose_bridge_open reads the first
+ * `size` bytes, so size must be 0 (every option at its default) or at least
+ * the 0.2 layout below (POSE_BRIDGE_OPTIONS_SIZE_0_2); fields a later version
+ * appends are read only when size covers them.
+ */
 typedef struct pose_bridge_options {
-    size_t size;              /**< sizeof(pose_bridge_options); 0 is taken as the defaults */
+    size_t size;              /**< sizeof(pose_bridge_options), or 0 for the defaults */
     const char *map_path;     /**< mapping file (JSON), or NULL */
     const char *map_json;     /**< the mapping as a string (instead of map_path), or NULL */
     const char *skeleton;     /**< .asf for an .amc source, or NULL to look beside it */
@@ -90,13 +100,26 @@ typedef struct pose_bridge_options {
     double speed;             /**< media seconds per second for POSE_BRIDGE_REALTIME; 0 = 1 */
     int loop;                 /**< recorded sources start over at their end */
     double start_s;           /**< recorded sources: initial media time */
+    double end_s;             /**< recorded sources: end (POSE_BRIDGE_ENDED) after the pose at this
+                                   media time; 0 = at the recording's end */
+    long max_poses;           /**< end after this many published poses; 0 = no limit */
     int start_paused;
     double rate_hz;           /**< clips: publish rate, slerping between frames; 0 = frame rate */
     double stale_after_s;     /**< live sources: silence after which the pose is held; 0 = 0.25 */
     int rt_priority;          /**< > 0: SCHED_FIFO priority of the bridge thread where allowed */
-    const char *record_path;  /**< record the applied joint angles as BVH (flushed per frame), or NULL */
-    pose_allocator allocator; /**< for the bridge's own allocations; zero = malloc/free */
+    const char *record_path;  /**< record the published joint angles as BVH (flushed per pose), or
+                                   NULL; ignored in POSE_BRIDGE_MANUAL */
+    /**
+     * Zero = malloc/free. Used for the handle and what it keeps for the host:
+     * copies of the strings above, the warnings, the pose pose_bridge_pose_at
+     * builds, status scratch. The parsers, decoders, mapping and the bridge
+     * thread's buffers use malloc.
+     */
+    pose_allocator allocator;
 } pose_bridge_options;
+
+/** Size of the 0.2 layout of pose_bridge_options: the least non-zero options.size accepted. */
+#define POSE_BRIDGE_OPTIONS_SIZE_0_2 (offsetof(pose_bridge_options, allocator) + sizeof(pose_allocator))
 
 /** Health of the source. */
 typedef enum pose_bridge_source_state {
@@ -111,17 +134,22 @@ typedef enum pose_bridge_source_state {
 /** What one pose_bridge_apply did. */
 typedef struct pose_bridge_frame {
     int fresh;          /**< a pose newer than the last apply was applied */
-    int held;           /**< the source is silent, lost or faulty: the last good pose holds */
+    int held;           /**< the source is stale, disconnected or faulty (a CAN node silent, a HID
+                             device unplugged ...): the last good values hold */
     int clamped;        /**< joints whose request a limit changed (pose_last_error names the last) */
     int joints;         /**< joints the bridge set */
     double media_s;     /**< source time of the applied pose (recorded time, or seconds since open) */
-    double age_s;       /**< how old the applied sample is */
+    double age_s;       /**< how old the applied pose is: seconds since the bridge thread published
+                             it (pose_bridge_pose_at: t_s minus the time of its newest sample) */
     uint64_t seq;       /**< increases by one per published pose; 0 before the first */
 } pose_bridge_frame;
 
-/** Counters and health (pose_bridge_status_get). */
+/**
+ * Counters and health (pose_bridge_status_get). The caller sets size; fields
+ * a later version appends are written only when size covers them.
+ */
 typedef struct pose_bridge_status {
-    size_t size;                    /**< sizeof(pose_bridge_status), set by the caller */
+    size_t size;                    /**< sizeof(pose_bridge_status): at least the 0.2 layout */
     pose_bridge_source_state state;
     int connected;                  /**< live device present (recorded sources: 1) */
     const char *kind;               /**< "bvh", "asf-amc", "hid", "hid-replay", "can", "candump-replay" */
@@ -131,14 +159,22 @@ typedef struct pose_bridge_status {
     double last_sample_age_s;       /**< since the last good sample; -1 before the first */
     double media_s;                 /**< source time of the newest pose */
     double duration_s;              /**< recorded sources: length; live: -1 */
-    double lag_p50_ms, lag_p99_ms;  /**< bridge thread wake-up lateness */
-    char fault[256];                /**< the last fault message, "" when none */
+    double lag_p50_ms, lag_p99_ms;  /**< bridge thread wake-up lateness (clips) */
+    double lag_max_ms;
+    int realtime;                   /**< the bridge thread got the rt_priority it asked for */
+    long frame;                     /**< clips: frame of the newest pose; -1 otherwise */
+    long frame_count;               /**< clips: frames; -1 otherwise */
+    double frame_time_s;            /**< clips: seconds per frame; 0 otherwise */
+    char fault[256];                /**< the last stale/disconnected/fault message, "" when none */
 } pose_bridge_status;
 
 /**
  * Open `source` (see the table above) for `rig` and, unless options->play is
- * POSE_BRIDGE_MANUAL, start the bridge thread. The rig must outlive the
- * bridge. On failure *out is NULL and pose_last_error() says why.
+ * POSE_BRIDGE_MANUAL, start the bridge thread. `options` may be NULL (the
+ * defaults). The rig must outlive the bridge. Files are read and checked
+ * here: on failure *out is NULL and pose_last_error() says why, naming the
+ * file and line (a mapping's unknown joint, a DBC syntax error ...). A live
+ * source cannot play POSE_BRIDGE_MANUAL.
  * @since 0.2
  */
 POSE_BRIDGE_API pose_status pose_bridge_open(const char *source, const pose_rig *rig,
@@ -148,36 +184,59 @@ POSE_BRIDGE_API void pose_bridge_close(pose_bridge *bridge);
 
 /**
  * Apply the newest pose to `state` (a state of the bridge's rig): never
- * blocks, allocates nothing. Joints the mapping drives are set; the others
- * are left as they are. `frame` may be NULL. POSE_CLAMPED when a limit
- * changed a joint. @since 0.2
+ * blocks, allocates nothing. Joints the mapping drives are set (every call,
+ * fresh or not); the others are left as they are; nothing is set before the
+ * first pose. `frame` may be NULL. POSE_CLAMPED when a limit changed a
+ * joint. In POSE_BRIDGE_MANUAL it sets nothing and reports the last
+ * pose_bridge_pose_at. @since 0.2
  */
 POSE_BRIDGE_API pose_status pose_bridge_apply(pose_bridge *bridge, pose_state *state, pose_bridge_frame *frame);
 /**
  * Recorded sources: set `state` to the pose at recorded time t_s, replaying
  * through the same decoder, mapping and filters as live play (as fast as
- * possible up to t_s; an earlier time starts over). Works in any play mode;
- * live sources return POSE_ERR_UNSUPPORTED. @since 0.2
+ * possible up to t_s; an earlier time starts over): the pose the bridge
+ * thread publishes at that time (clips: the last tick at or before t_s;
+ * recordings: after every sample up to t_s). frame->held when the source was
+ * stale or faulty at t_s, or its newest sample is older than stale_after_s.
+ * Works in any play mode, on the calling thread (its own replay, not the
+ * bridge thread's); POSE_ERR_INVALID_ARGUMENT past the recording's end, and
+ * POSE_ERR_UNSUPPORTED for live sources. @since 0.2
  */
 POSE_BRIDGE_API pose_status pose_bridge_pose_at(pose_bridge *bridge, double t_s, pose_state *state,
                                                 pose_bridge_frame *frame);
 
 /** Snapshot of the counters; status->size must be set. @since 0.2 */
 POSE_BRIDGE_API pose_status pose_bridge_status_get(pose_bridge *bridge, pose_bridge_status *status);
-/** Recorded sources: pause or resume the bridge thread. @since 0.2 */
+/**
+ * Recorded sources played by the bridge thread: pause or resume. A paused
+ * recording reads nothing and resumes where it stopped. Live sources and
+ * POSE_BRIDGE_MANUAL: POSE_ERR_UNSUPPORTED. @since 0.2
+ */
 POSE_BRIDGE_API pose_status pose_bridge_pause(pose_bridge *bridge, int paused);
-/** Recorded sources: continue playing from media time t_s. @since 0.2 */
+/**
+ * Recorded sources played by the bridge thread: continue from media time
+ * t_s. A paused clip publishes the pose at t_s at once (so seeking while
+ * paused steps). @since 0.2
+ */
 POSE_BRIDGE_API pose_status pose_bridge_seek(pose_bridge *bridge, double t_s);
-/** Recorded sources: playing speed (media s per s; > 0). @since 0.2 */
+/**
+ * Clips played by the bridge thread: playing speed (media s per s; > 0).
+ * HID and CAN recordings play at the options.speed they were opened with
+ * (POSE_ERR_UNSUPPORTED here). @since 0.2
+ */
 POSE_BRIDGE_API pose_status pose_bridge_set_speed(pose_bridge *bridge, double speed);
-/** Block until a recorded source has ended (1) or timeout_ms passed (0); -1 forever. @since 0.2 */
+/**
+ * Block until the bridge thread has ended (1: a recording's end, end_s or
+ * max_poses) or timeout_ms passed (0); -1 waits forever. POSE_BRIDGE_MANUAL:
+ * 0 at once. @since 0.2
+ */
 POSE_BRIDGE_API int pose_bridge_wait(pose_bridge *bridge, int timeout_ms);
 
 /**
  * Warnings the source's files raised while loading (a HID descriptor's
  * trailing bytes, a DBC's repeated pseudo-message signals, a mapping's
  * duplicate key ...): each names the file and line or offset. Valid until
- * the bridge is closed. @since 0.2
+ * the bridge is closed; NULL past the count. The first 32 are kept. @since 0.2
  */
 POSE_BRIDGE_API size_t pose_bridge_warning_count(const pose_bridge *bridge);
 POSE_BRIDGE_API const char *pose_bridge_warning(const pose_bridge *bridge, size_t index);

@@ -3,9 +3,11 @@
 
 #include <pthread.h>
 #include <sched.h>
+#include <stdatomic.h>
 #if defined(__linux__)
 #include <sys/prctl.h>
 #endif
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -43,6 +45,7 @@ struct pb_runner {
     size_t lag_count;
     pb_error err;
     pose_status status;
+    atomic_int source_state; /* stats.source, for readers that must not lock */
 };
 
 static void abs_deadline(int64_t t_ns, struct timespec *ts)
@@ -55,6 +58,10 @@ static void note_tick(pb_runner *r, const pb_pose *p, int64_t lag_ns)
 {
     /* caller holds mu */
     r->stats.ticks++;
+    if (r->clip) {
+        r->stats.samples++;
+        r->stats.last_sample_ns = p->t_ns;
+    }
     r->stats.frame = p->frame;
     r->stats.media_s = p->media_s;
     r->stats.lag_ms = (double)lag_ns * 1e-6;
@@ -198,22 +205,80 @@ static void *clip_thread(void *arg)
     return NULL;
 }
 
+/* After each read, on the bridge thread: the source's health, the last
+ * fault's message and the sample counters. */
+static void note_source(pb_runner *r, int got_sample)
+{
+    pb_source_state st = r->src->state;
+    uint64_t drops = r->opt.count_drops ? r->opt.count_drops(r->src) : 0;
+    pthread_mutex_lock(&r->mu);
+    if (st != r->stats.source && (st == PB_SOURCE_STALE || st == PB_SOURCE_DISCONNECTED || st == PB_SOURCE_FAULT))
+        snprintf(r->stats.fault, sizeof r->stats.fault, "%s", r->src->message);
+    r->stats.source = st;
+    r->stats.drops = drops;
+    if (got_sample) {
+        r->stats.samples++;
+        r->stats.last_sample_ns = pb_now_ns();
+    }
+    pthread_mutex_unlock(&r->mu);
+    atomic_store_explicit(&r->source_state, (int)st, memory_order_release);
+}
+
+/* Pause and seek for replays, under mu. A paused replay reads nothing; the
+ * replay paces itself from the wall time of its last seek, so resuming (or
+ * seeking) re-anchors it with a seek. Returns the recorded time to seek
+ * to, or -1; *stop when the runner is stopping. */
+static int64_t source_control(pb_runner *r, int64_t last_t_ns, int *stop)
+{
+    int64_t seek_to = -1;
+    pthread_mutex_lock(&r->mu);
+    for (int was_paused = 0;;) {
+        if (r->stop_req)
+            break;
+        if (r->seek_req) {
+            seek_to = (int64_t)(r->seek_to * 1e9 + 0.5);
+            r->seek_req = 0;
+        }
+        if (!r->paused) {
+            if (was_paused && seek_to < 0)
+                seek_to = last_t_ns + 1; /* continue after the last update delivered */
+            break;
+        }
+        was_paused = 1;
+        struct timespec ts;
+        abs_deadline(pb_now_ns() + 50000000, &ts);
+        pthread_cond_timedwait(&r->cv, &r->mu, &ts);
+    }
+    *stop = r->stop_req;
+    pthread_mutex_unlock(&r->mu);
+    return seek_to;
+}
+
 static void *source_thread(void *arg)
 {
     pb_runner *r = arg;
     apply_priority(r);
-    /* Media time counts from the first update's own timestamp: live sources
-     * stamp with CLOCK_MONOTONIC, replays with recorded time. */
-    int64_t t0 = 0;
-    int have_t0 = 0;
+    /* Media time: a replay's recorded time, or, for live sources (stamped
+     * with CLOCK_MONOTONIC), time since the first update. */
+    int64_t t0 = 0, last_t = -1;
+    int have_t0 = r->opt.recorded;
+    if (r->opt.recorded && r->opt.start_s > 0)
+        pb_source_seek(r->src, (int64_t)(r->opt.start_s * 1e9 + 0.5));
     for (;;) {
-        pthread_mutex_lock(&r->mu);
-        int stop = r->stop_req;
-        pthread_mutex_unlock(&r->mu);
+        int stop;
+        int64_t seek_to = r->opt.recorded ? source_control(r, last_t, &stop) : -1;
+        if (!r->opt.recorded) {
+            pthread_mutex_lock(&r->mu);
+            stop = r->stop_req;
+            pthread_mutex_unlock(&r->mu);
+        }
         if (stop)
             break;
+        if (seek_to >= 0)
+            pb_source_seek(r->src, seek_to);
         pb_update u;
         int got = pb_source_read(r->src, &u, 20);
+        note_source(r, got == 1);
         if (got < 0) {
             if (r->src->state == PB_SOURCE_ENDED) {
                 finish(r, PB_SOURCE_ENDED);
@@ -228,11 +293,17 @@ static void *source_thread(void *arg)
             t0 = u.t_ns;
             have_t0 = 1;
         }
+        double media = (double)(u.t_ns - t0) * 1e-9;
+        if (r->opt.max_media_s > 0 && media - r->opt.start_s > r->opt.max_media_s + 1e-9) {
+            finish(r, PB_SOURCE_ENDED);
+            return NULL;
+        }
+        last_t = u.t_ns;
         pb_chanmap_update(r->cm, &u);
         pb_pose *back = pb_handoff_back(&r->h);
         pb_chanmap_pose(r->cm, back);
         back->t_ns = pb_now_ns();
-        back->media_s = (double)(u.t_ns - t0) * 1e-9;
+        back->media_s = media;
         back->frame = -1;
         if (publish(r, back, 0))
             break;
@@ -282,6 +353,8 @@ static pose_status runner_new(const pb_rig_skel *rig, const pb_runner_options *o
     r->paused = r->opt.start_paused;
     r->period = r->opt.rate_hz > 0 ? r->speed / r->opt.rate_hz : frame_time;
     r->stats.state = PB_SOURCE_WAITING;
+    r->stats.source = PB_SOURCE_WAITING;
+    atomic_init(&r->source_state, (int)PB_SOURCE_WAITING);
     r->stats.running = 1;
     r->stats.frame = -1;
     r->lags = malloc(LAG_CAPACITY * sizeof *r->lags);
@@ -336,6 +409,8 @@ pose_status pb_runner_start_clip(const pb_clip *clip, const pb_rig_skel *rig, co
         return s;
     }
     r->stats.state = PB_SOURCE_OK;
+    r->stats.source = PB_SOURCE_OK;
+    atomic_init(&r->source_state, (int)PB_SOURCE_OK);
     return runner_launch(r, clip_thread, out, err);
 }
 
@@ -366,6 +441,11 @@ pose_status pb_runner_start_source(pb_source *src, const pb_rig_skel *rig, const
 }
 
 const pb_pose *pb_runner_latest(pb_runner *r, int *fresh) { return pb_handoff_latest(&r->h, fresh); }
+
+pb_source_state pb_runner_source_state(pb_runner *r)
+{
+    return (pb_source_state)atomic_load_explicit(&r->source_state, memory_order_acquire);
+}
 
 void pb_runner_stats_get(pb_runner *r, pb_runner_stats *out)
 {

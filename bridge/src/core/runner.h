@@ -32,6 +32,11 @@ typedef struct pb_runner_options {
     const char *record_path; /**< BVH of the applied joint angles, or NULL */
     int rt_priority;   /**< > 0: run the bridge thread SCHED_FIFO at this priority (1..99)
                             when the system allows it (see pb_runner_stats.realtime) */
+    int recorded;      /**< sources: update times are recorded times, media time = t_ns (a
+                            replay); 0: media time counts from the first update (live) */
+    /** Sources: samples the backend rejected or lost so far (pb_runner_stats.drops), polled on
+     *  the bridge thread after each read; NULL counts none. */
+    uint64_t (*count_drops)(pb_source *src);
 } pb_runner_options;
 
 typedef struct pb_runner_stats {
@@ -44,6 +49,12 @@ typedef struct pb_runner_stats {
     pb_source_state state; /**< PB_SOURCE_OK while running, ENDED at the end */
     int running;
     int realtime;          /**< the thread got the SCHED_FIFO priority it asked for */
+    pb_source_state source;/**< the source's own health (STALE while a CAN node is silent ...);
+                                clips: PB_SOURCE_OK */
+    char fault[256];       /**< message of the last STALE, DISCONNECTED or FAULT state; "" when none */
+    uint64_t samples;      /**< source updates read (clips: poses) */
+    uint64_t drops;        /**< options.count_drops */
+    int64_t last_sample_ns;/**< CLOCK_MONOTONIC arrival of the newest sample; 0 before the first */
 } pb_runner_stats;
 
 typedef struct pb_runner pb_runner;
@@ -65,8 +76,12 @@ pose_status pb_runner_start_source(pb_source *src, const pb_rig_skel *rig, const
                                    const pb_runner_options *opt, pb_runner **out, pb_error *err);
 /** Host side, never blocks: the newest pose (see pb_handoff_latest). */
 const pb_pose *pb_runner_latest(pb_runner *r, int *fresh);
+/** The source's health (pb_runner_stats.source) without locking, for the host's frame loop. */
+pb_source_state pb_runner_source_state(pb_runner *r);
 /** Snapshot of the counters (takes the control mutex briefly). */
 void pb_runner_stats_get(pb_runner *r, pb_runner_stats *out);
+/** Clips and replays (a source with seek): a paused replay reads nothing; on resume it
+ *  continues from the last update it delivered. */
 void pb_runner_pause(pb_runner *r, int paused);
 void pb_runner_seek(pb_runner *r, double media_s);
 /** While paused: publish the next `ticks` poses, one period apart (ignored while playing). */
