@@ -12,6 +12,7 @@
 
 #include "hid_mannequin.h"
 #include "hid_report.h"
+#include "pb_warn.h"
 
 #define PARSE_ERR(bytes, text) parse_err(bytes, sizeof bytes, text)
 
@@ -47,10 +48,24 @@ static void test_invalid(void **state)
     PARSE_ERR(truncated, "needs 2 data bytes");
     static const uint8_t truncated_at[] = {0x05, 0x01, 0x27, 0xFF};
     parse_err(truncated_at, sizeof truncated_at, "byte 2:");
-    static const uint8_t long_past[] = {0xFE, 0x05, 0x10, 0x00};
-    PARSE_ERR(long_past, "long item");
-    static const uint8_t long_short[] = {0xFE, 0x05};
-    PARSE_ERR(long_short, "truncated long item");
+    /* Long items: the kernel's fetch_item reads them, hid_open_report refuses them. */
+    static const uint8_t long_item[] = {0xFE, 0x02, 0x10, 0xAA, 0xBB};
+    PARSE_ERR(long_item, "long item (prefix 0xfe): the Linux kernel refuses long items");
+    static const uint8_t long_short[] = {0x05, 0x01, 0xFE, 0x05};
+    PARSE_ERR(long_short, "byte 2: long item");
+    static const uint8_t long_f0[] = {0xF0};
+    PARSE_ERR(long_f0, "long item (prefix 0xf0)");
+    /* Reserved global tags: hid_parser_global fails ("unknown global tag"). */
+    static const uint8_t global_reserved[] = {0x05, 0x01, 0xC4, 0x01};
+    PARSE_ERR(global_reserved, "byte 2: reserved global item tag 0xc");
+    /* Report Count above HID_MAX_USAGES (12288). */
+    static const uint8_t count_big[] = {0x96, 0x01, 0x30};
+    PARSE_ERR(count_big, "report count 12289 too large");
+    /* hid_add_field: logical maximum below the minimum, even for padding. */
+    static const uint8_t range_bad[] = {0x15, 0x05, 0x25, 0x01, 0x75, 0x08, 0x95, 0x01, 0x81, 0x03};
+    PARSE_ERR(range_bad, "byte 8: logical maximum 1 below logical minimum 5");
+    static const uint8_t range_bad_signed[] = {0x15, 0xFE, 0x25, 0xFD, 0x75, 0x08, 0x95, 0x01, 0x81, 0x02};
+    PARSE_ERR(range_bad_signed, "logical maximum -3 below logical minimum -2");
     static const uint8_t end_without[] = {0xC0};
     PARSE_ERR(end_without, "End Collection without");
     static const uint8_t unclosed[] = {0x05, 0x01, 0x09, 0x02, 0xA1, 0x01};
@@ -75,8 +90,6 @@ static void test_invalid(void **state)
     PARSE_ERR(delim, "delimiter close");
     static const uint8_t delim_open[] = {0xA9, 0x01};
     PARSE_ERR(delim_open, "delimiter not closed");
-    static const uint8_t main_reserved[] = {0xD0};
-    PARSE_ERR(main_reserved, "reserved main item");
     uint8_t pushes[2 * PB_HID_MAX_DEPTH + 2];
     for (size_t i = 0; i < sizeof pushes; i++)
         pushes[i] = 0xA4;
@@ -199,7 +212,6 @@ static void test_report_ids_and_extended_usages(void **state)
         0x85, 0x02, 0x09, 0x05, 0x75, 0x08, 0x95, 0x01, 0x81, 0x02, /* Button 5 */
         0x85, 0x03, 0x09, 0x06, 0x91, 0x02,                         /* output only */
         0x85, 0x01, 0x09, 0x07, 0x81, 0x02,                         /* report 1 continues */
-        0xFE, 0x02, 0x10, 0xAA, 0xBB,                               /* long item: skipped */
         0x0C,                                                       /* reserved type: skipped */
     };
     pb_hid_desc *d = parse_ok(b, sizeof b);
@@ -431,6 +443,96 @@ static void test_mannequin(void **state)
     pb_hid_desc_free(d);
 }
 
+/* What the Linux kernel accepts with a warning (drivers/hid/hid-core.c): a
+ * main item with a reserved tag, such as a 0x00 byte after the last End
+ * Collection (hid_parser_main: "unknown main item tag", locals reset), an item
+ * of the reserved type 3 (hid_parser_reserved) and a local item with a
+ * reserved tag (hid_parser_local). The fields are those of the descriptor
+ * without the odd items, and reports decode the same. */
+static void test_kernel_tolerated_items(void **state)
+{
+    (void)state;
+    pb_warnings w = {0};
+    pb_warnings *prev = pb_warnings_install(&w);
+
+    /* The boot mouse with one trailing 0x00 (byte 52). */
+    uint8_t trailing[sizeof mouse + 1];
+    memcpy(trailing, mouse, sizeof mouse);
+    trailing[sizeof mouse] = 0x00;
+    pb_hid_desc *d = parse_ok(trailing, sizeof trailing);
+    assert_int_equal(w.count, 1);
+    assert_string_equal(w.text[0], "t.bin: report descriptor byte 52: 1 trailing 0x00 byte after the last item skipped, "
+                                   "as the Linux kernel does");
+    assert_int_equal(d->field_count, 7);
+    assert_int_equal(d->channel_count, 6);
+    assert_int_equal(pb_hid_desc_input_length(d, 0), 4);
+    int32_t lg[6];
+    double v[6];
+    uint8_t ok[6];
+    uint32_t first, count;
+    const uint8_t rep[] = {0x05, 0xFE, 0x02, 0x01}; /* buttons 1 and 3, X -2, Y 2, wheel 1 */
+    assert_int_equal(pb_hid_report_decode(d, rep, sizeof rep, lg, v, ok, &first, &count), PB_HID_DECODE_OK);
+    assert_int_equal(count, 6);
+    const int32_t expect[6] = {1, 0, 1, -2, 2, 1};
+    for (int c = 0; c < 6; c++)
+        assert_int_equal(lg[c], expect[c]);
+    pb_hid_desc_free(d);
+
+    /* Several zero bytes: one warning naming where they start. */
+    w.count = 0;
+    uint8_t zeros[sizeof mouse + 3] = {0};
+    memcpy(zeros, mouse, sizeof mouse);
+    d = parse_ok(zeros, sizeof zeros);
+    assert_int_equal(w.count, 1);
+    assert_non_null(strstr(w.text[0], "byte 52: 3 trailing 0x00 bytes"));
+    assert_int_equal(d->field_count, 7);
+    pb_hid_desc_free(d);
+
+    /* Reserved items inside: a main item with tag 0 between Usage (X) and Usage (Y)
+     * clears the pending usages as every main item does, so the two values get
+     * Y and then Y again (the last usage repeats); a reserved-type item (0x0D, one
+     * data byte) and reserved local tags (0x68, 0xB9 with one byte) are skipped. */
+    static const uint8_t odd[] = {
+        0x05, 0x01, 0x09, 0x02, 0xA1, 0x01,       /* 0: Application (Mouse) */
+        0x09, 0x30, 0x00, 0x09, 0x31,             /* 6: X, reserved main tag 0 at byte 8, Y */
+        0x0D, 0x7F,                               /* 11: reserved type 3, tag 0 */
+        0x68,                                     /* 13: local tag 6 (reserved) */
+        0xB9, 0x01,                               /* 14: local tag 0xB (reserved) */
+        0x15, 0x81, 0x25, 0x7F, 0x75, 0x08, 0x95, 0x02, 0x81, 0x06,
+        0xD0,                                     /* 26: main tag 0xD (reserved) */
+        0xC0,
+    };
+    w.count = 0;
+    d = parse_ok(odd, sizeof odd);
+    assert_int_equal(w.count, 5);
+    assert_string_equal(w.text[0], "t.bin: report descriptor byte 8: main item with reserved tag 0x0 (prefix 0x00) "
+                                   "skipped, as the Linux kernel does");
+    assert_string_equal(w.text[1], "t.bin: report descriptor byte 11: item of reserved type 3 (prefix 0x0d) skipped, "
+                                   "as the Linux kernel does");
+    assert_non_null(strstr(w.text[2], "byte 13: local item with reserved tag 0x6 (prefix 0x68) skipped"));
+    assert_non_null(strstr(w.text[3], "byte 14: local item with reserved tag 0xb (prefix 0xb9) skipped"));
+    assert_non_null(strstr(w.text[4], "byte 26: main item with reserved tag 0xd (prefix 0xd0) skipped"));
+    assert_int_equal(d->field_count, 2);
+    assert_string_equal(d->channels[0].name, "GenericDesktop.Y");
+    assert_string_equal(d->channels[1].name, "GenericDesktop.Y#1");
+    assert_int_equal(d->fields[1].bit_offset, 8);
+    pb_hid_desc_free(d);
+
+    /* More warnings than the sink keeps are counted; without a sink they are dropped. */
+    uint8_t many[40];
+    memset(many, 0x0C, sizeof many);
+    w.count = 0;
+    d = parse_ok(many, sizeof many);
+    assert_int_equal(w.count, PB_WARN_MAX);
+    assert_int_equal(w.dropped, sizeof many - PB_WARN_MAX);
+    pb_hid_desc_free(d);
+    pb_warnings_install(NULL);
+    d = parse_ok(trailing, sizeof trailing);
+    assert_int_equal(d->field_count, 7);
+    pb_hid_desc_free(d);
+    pb_warnings_install(prev);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -443,6 +545,7 @@ int main(void)
         cmocka_unit_test(test_collections_delimiters_null),
         cmocka_unit_test(test_unaligned_32bit),
         cmocka_unit_test(test_mannequin),
+        cmocka_unit_test(test_kernel_tolerated_items),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

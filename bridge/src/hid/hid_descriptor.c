@@ -5,6 +5,23 @@
  * out the bytes; the kernel's parser is GPL and in-kernel), and the item
  * grammar is small. Behaviour follows HID 1.11 section 6.2.2, with the
  * kernel's readings where the spec is loose (noted where they apply).
+ *
+ * What real descriptors get away with is decided by what the Linux kernel
+ * accepts (drivers/hid/hid-core.c, hid_open_report and the hid_parser_*
+ * dispatchers), since that is what runs these devices:
+ *   - a main item with a reserved tag, e.g. a stray 0x00 byte after the last
+ *     End Collection: the kernel logs "unknown main item tag" and goes on
+ *     (hid_parser_main); here: skipped with a warning (pb_warn);
+ *   - an item of the reserved type 3, and a local item with a reserved tag:
+ *     the kernel skips them (hid_parser_reserved, hid_parser_local); here:
+ *     skipped with a warning;
+ *   - a global item with a reserved tag: the kernel refuses the descriptor
+ *     ("unknown global tag"), so do we;
+ *   - a long item (any prefix 0xF0..0xFF): the kernel's fetch_item reads it
+ *     and hid_open_report then refuses it ("unexpected long global item"),
+ *     so do we (hid-tools refuses it too);
+ *   - a Report Count above 12288 (the kernel's HID_MAX_USAGES) and a logical
+ *     maximum below the logical minimum (hid_add_field) are refused.
  */
 #include "hid_descriptor.h"
 
@@ -13,6 +30,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "pb_warn.h"
 
 /* Item types and tags (HID 1.11, 6.2.2.4-6.2.2.8). */
 enum { TYPE_MAIN = 0, TYPE_GLOBAL = 1, TYPE_LOCAL = 2, TYPE_RESERVED = 3 };
@@ -23,7 +42,8 @@ enum {
     G_REPORT_ID = 0x8, G_REPORT_COUNT = 0x9, G_PUSH = 0xA, G_POP = 0xB,
 };
 enum { L_USAGE = 0x0, L_USAGE_MIN = 0x1, L_USAGE_MAX = 0x2, L_DELIMITER = 0xA };
-#define LONG_ITEM_PREFIX 0xFE
+#define LONG_ITEM_TAG 0xF        /* the kernel's HID_ITEM_TAG_LONG: any prefix 0xF0..0xFF */
+#define KERNEL_MAX_REPORT_COUNT 12288 /* the kernel's HID_MAX_USAGES */
 
 /* Global state; Push/Pop copy it whole. Maxima keep both readings of their
  * bytes because whether they are signed depends on the minimum (kernel rule:
@@ -42,7 +62,8 @@ typedef struct usage_range {
 } usage_range;
 
 typedef struct parser {
-    size_t pos;
+    size_t pos, len;
+    uint8_t byte; /* prefix of the item at pos */
     const char *origin;
     pb_error *err;
     pose_status status;
@@ -80,6 +101,23 @@ static int fail(parser *p, const char *fmt, ...)
         p->status = strcmp(msg, "out of memory") == 0 ? POSE_ERR_OUT_OF_MEMORY : POSE_ERR_FORMAT;
     pb_fail(p->err, p->status, "%s: report descriptor byte %zu: %s", p->origin, p->pos, msg);
     return -1;
+}
+
+/* A warning about the item at p->pos, naming the origin and byte offset. */
+static void warn_at(const parser *p, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+static void warn_at(const parser *p, const char *fmt, ...)
+{
+    char msg[192];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    pb_warn("%s: report descriptor byte %zu: %s", p->origin, p->pos, msg);
 }
 
 static void clear_locals(parser *p)
@@ -220,6 +258,11 @@ static int main_data(parser *p, uint32_t tag, uint32_t data)
     uint32_t rid = g->report_id;
     if (rid == 0)
         p->seen_data_without_id = true;
+    /* hid_add_field refuses a logical maximum below the minimum, padding included. */
+    if (g->logical_min < 0 ? g->logical_max_s < g->logical_min
+                           : (uint32_t)g->logical_max_u < (uint32_t)g->logical_min)
+        return fail(p, "logical maximum %lld below logical minimum %lld",
+                    (long long)(g->logical_min < 0 ? g->logical_max_s : g->logical_max_u), (long long)g->logical_min);
     uint64_t total = (uint64_t)g->report_size * g->report_count;
     uint32_t *bits = &p->bits[kind][rid];
     if ((uint64_t)*bits + total > (uint64_t)PB_HID_MAX_REPORT_BYTES * 8)
@@ -316,7 +359,11 @@ static int main_item(parser *p, uint32_t tag, uint32_t data)
         clear_locals(p);
         return 0;
     default:
-        return fail(p, "reserved main item tag 0x%x", tag);
+        /* hid_parser_main: "unknown main item tag", then the locals are reset as for any main item. */
+        warn_at(p, "main item with reserved tag 0x%x (prefix 0x%02x) skipped, as the Linux kernel does", tag,
+                p->byte);
+        clear_locals(p);
+        return 0;
     }
 }
 
@@ -364,8 +411,8 @@ static int global_item(parser *p, uint32_t tag, uint32_t u, int32_t s)
         p->d->uses_report_ids = true;
         break;
     case G_REPORT_COUNT:
-        if (u > (uint32_t)PB_HID_MAX_REPORT_BYTES * 8)
-            return fail(p, "report count %u too large", u);
+        if (u > KERNEL_MAX_REPORT_COUNT)
+            return fail(p, "report count %u too large (the Linux kernel allows %d)", u, KERNEL_MAX_REPORT_COUNT);
         g->report_count = u;
         break;
     case G_PUSH:
@@ -379,7 +426,8 @@ static int global_item(parser *p, uint32_t tag, uint32_t u, int32_t s)
         *g = p->stack[--p->stack_depth];
         break;
     default:
-        break; /* reserved global tags carry no meaning yet: skipped, as the kernel does */
+        /* hid_parser_global: "unknown global tag", and the descriptor is refused. */
+        return fail(p, "reserved global item tag 0x%x (the Linux kernel refuses it)", tag);
     }
     return 0;
 }
@@ -425,8 +473,13 @@ static int local_item(parser *p, uint32_t tag, uint32_t u, size_t size)
             return fail(p, "delimiter value %u", u);
         }
         return 0;
-    default:
+    case 0x3: case 0x4: case 0x5: case 0x7: case 0x8: case 0x9:
         return 0; /* designators and strings: no effect on the report layout */
+    default:
+        /* hid_parser_local ignores unknown local tags. */
+        warn_at(p, "local item with reserved tag 0x%x (prefix 0x%02x) skipped, as the Linux kernel does", tag,
+                p->byte);
+        return 0;
     }
 }
 
@@ -532,21 +585,29 @@ pose_status pb_hid_desc_parse(const uint8_t *bytes, size_t len, const char *orig
         fail(p, "descriptor of %zu bytes exceeds %d", len, PB_HID_MAX_DESC_BYTES);
         goto done;
     }
+    p->len = len;
     while (p->pos < len) {
         uint8_t prefix = bytes[p->pos];
-        if (prefix == LONG_ITEM_PREFIX) {
-            /* Long items (bDataSize, bLongItemTag, data) have no defined tags: skipped. */
-            if (p->pos + 3 > len) {
-                fail(p, "truncated long item");
-                goto done;
+        p->byte = prefix;
+        if ((prefix >> 4) == LONG_ITEM_TAG) {
+            /* Long items have no defined tags; the kernel refuses them in hid_open_report. */
+            fail(p, "long item (prefix 0x%02x): the Linux kernel refuses long items", prefix);
+            goto done;
+        }
+        if (prefix == 0x00) {
+            /* Zero padding at the end (seen on real devices): each 0x00 is a Main item with
+             * the reserved tag 0, which the kernel warns about and skips; hid-tools skips one
+             * trailing 0x00. One warning for the run. */
+            size_t z = p->pos;
+            while (z < len && bytes[z] == 0x00)
+                z++;
+            if (z == len) {
+                warn_at(p, "%zu trailing 0x00 byte%s after the last item skipped, as the Linux kernel does",
+                        len - p->pos, len - p->pos == 1 ? "" : "s");
+                clear_locals(p);
+                p->pos = len;
+                break;
             }
-            size_t skip = 3 + (size_t)bytes[p->pos + 1];
-            if (p->pos + skip > len) {
-                fail(p, "long item of %zu bytes runs past the end", skip);
-                goto done;
-            }
-            p->pos += skip;
-            continue;
         }
         size_t size = prefix & 3;
         if (size == 3)
@@ -574,7 +635,9 @@ pose_status pb_hid_desc_parse(const uint8_t *bytes, size_t len, const char *orig
             r = local_item(p, tag, u, size);
             break;
         default:
-            break; /* reserved item type: skipped, as the kernel does */
+            /* hid_parser_reserved: skipped. */
+            warn_at(p, "item of reserved type 3 (prefix 0x%02x) skipped, as the Linux kernel does", prefix);
+            break;
         }
         if (r != 0)
             goto done;
