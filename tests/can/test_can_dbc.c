@@ -15,6 +15,7 @@
 
 #include "dbc_decode.h"
 #include "dbc_parse.h"
+#include "pb_warn.h"
 
 static pb_dbc *parse_ok(const char *text)
 {
@@ -300,6 +301,85 @@ static void test_rig_dbc(void **state)
     pb_dbc_free(d);
 }
 
+/* VECTOR__INDEPENDENT_SIG_MSG, CANdb++'s holder of signals that belong to no
+ * message: cantools drops it by name before building messages
+ * (formats/dbc.py, _load_messages), so nothing in it is checked beyond the
+ * grammar; repeated signal names there load. Here: dropped too, each repeat
+ * a warning naming file and line; references to its identifier are quiet. */
+static void test_pseudo_message(void **state)
+{
+    (void)state;
+    pb_warnings w = {0};
+    pb_warnings *prev = pb_warnings_install(&w);
+
+    /* The real file of cantools issue 62 (a J1939 export): only the pseudo-message,
+     * 18 signals, no repeats. cantools loads it with no message at all. */
+    pb_dbc *d = load_data("can/cantools-dbc/issue_62.dbc");
+    assert_int_equal(d->message_count, 0);
+    assert_int_equal(d->warning_count, 0);
+    assert_int_equal(w.count, 0);
+    assert_null(pb_dbc_find(d, 0x40000000, 1));
+    assert_null(pb_dbc_find(d, 0, 1));
+    pb_dbc_free(d);
+
+    /* Repeated names, as CANdb++ writes them when messages holding same-named
+     * signals are deleted, around a real message. */
+    static const char text[] =
+        "VERSION \"\"\n"                                                            /* 1 */
+        "BU_: ECU\n"                                                                 /* 2 */
+        "BO_ 3221225472 VECTOR__INDEPENDENT_SIG_MSG: 0 Vector__XXX\n"                /* 3 */
+        " SG_ Checksum : 0|8@1+ (1,0) [0|0] \"\" Vector__XXX\n"                     /* 4 */
+        " SG_ Counter : 0|4@1+ (1,0) [0|15] \"\" Vector__XXX\n"                     /* 5 */
+        " SG_ Checksum : 0|8@0+ (1,0) [0|255] \"\" Vector__XXX\n"                   /* 6 */
+        " SG_ Counter : 0|4@1+ (1,0) [0|15] \"\" Vector__XXX\n"                     /* 7 */
+        " SG_ Spare : 0|32@1- (1,0) [0|0] \"\" Vector__XXX\n"                       /* 8 */
+        "\n"                                                                         /* 9 */
+        "BO_ 291 Status: 2 ECU\n"                                                    /* 10 */
+        " SG_ Counter : 0|4@1+ (1,0) [0|15] \"\" Vector__XXX\n"                     /* 11 */
+        " SG_ Checksum : 8|8@1+ (1,0) [0|255] \"\" Vector__XXX\n"                   /* 12 */
+        "CM_ BO_ 3221225472 \"This is a message for not used signals, created by Vector CANdb++ DBC OLE DB "
+        "Provider.\";\n"                                                            /* 13 */
+        "VAL_ 3221225472 Counter 0 \"zero\" ;\n"                                     /* 14 */
+        "SIG_VALTYPE_ 3221225472 Spare : 2;\n"                                       /* 15: 32 bits as double */
+        "BA_ \"GenMsgCycleTime\" BO_ 3221225472 100;\n"                               /* 16 */
+        "VAL_ 291 Counter 15 \"max\" ;\n";                                           /* 17 */
+    d = parse_ok(text);
+    assert_int_equal(d->message_count, 1);
+    const pb_dbc_message *m = pb_dbc_find(d, 291, 0);
+    assert_non_null(m);
+    assert_string_equal(m->name, "Status");
+    assert_int_equal(m->signal_count, 2);
+    assert_string_equal(m->signals[1].name, "Checksum");
+    assert_int_equal(m->signals[1].start, 8);
+    assert_int_equal(m->signals[0].choice_count, 1);
+    assert_int_equal(d->warning_count, 2);
+    assert_string_equal(d->warning, "inline.dbc:6: signal Checksum repeats in VECTOR__INDEPENDENT_SIG_MSG (first at "
+                                    "line 4); that pseudo-message of signals in no message is skipped, as cantools "
+                                    "skips it");
+    assert_int_equal(w.count, 2);
+    assert_string_equal(w.text[0], d->warning);
+    assert_non_null(strstr(w.text[1], "inline.dbc:7: signal Counter repeats in VECTOR__INDEPENDENT_SIG_MSG (first at "
+                                      "line 5)"));
+    const uint8_t f[2] = {0x0A, 0x5C};
+    double v[2];
+    uint8_t pr[2];
+    assert_int_equal(pb_dbc_decode(m, f, 2, v, NULL, pr), 2);
+    assert_true(v[0] == 10.0 && v[1] == 0x5C);
+    pb_dbc_free(d);
+
+    /* Its SG_ lines must still be well formed (cantools' grammar parses them). */
+    parse_fails("BO_ 3221225472 VECTOR__INDEPENDENT_SIG_MSG: 0 Vector__XXX\n"
+                " SG_ a : 0|8@1* (1,0) [0|0] \"\" Vector__XXX\n",
+                2, "'+' or '-'");
+    /* Any other identifier beyond 29 bits is refused, as cantools' Message refuses it. */
+    parse_fails("BO_ 3221225473 Other: 8 N\n", 1, "exceeds 29 bits");
+    parse_fails("BO_ 1073741824 Other: 8 N\n", 1, "exceeds 29 bits");
+    /* Repeats in a real message stay an error. */
+    parse_fails("BO_ 1 M: 8 N\n SG_ a : 0|8@1+ (1,0) [0|0] \"\" N\n SG_ a : 8|8@1+ (1,0) [0|0] \"\" N\n", 3,
+                "defined twice");
+    pb_warnings_install(prev);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -308,6 +388,7 @@ int main(void)
         cmocka_unit_test(test_cantools_files),
         cmocka_unit_test(test_multiplexing),
         cmocka_unit_test(test_rig_dbc),
+        cmocka_unit_test(test_pseudo_message),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

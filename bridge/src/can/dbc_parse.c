@@ -7,6 +7,17 @@
  * longjmp back to pb_dbc_parse, which frees the half-built result: every
  * allocation hangs off the pb_dbc (an arena for strings and small arrays,
  * realloc'd vectors for messages and signals).
+ *
+ * Real files are judged by what cantools loads (database/can/formats/dbc.py
+ * and database/can/message.py):
+ *   - a message named VECTOR__INDEPENDENT_SIG_MSG is CANdb++'s holder for
+ *     signals that belong to no message; cantools drops it, whatever its
+ *     signals (_load_messages), so its signals may repeat names. Here its
+ *     SG_ lines are still checked for syntax, then dropped; each repeated
+ *     name is a warning (pb_warn), and statements that refer to its
+ *     identifier (VAL_, SIG_VALTYPE_, SG_MUL_VAL_, BA_) are skipped quietly;
+ *   - any other message whose identifier exceeds 29 bits is refused, as
+ *     cantools' Message refuses it.
  */
 #include "dbc_parse.h"
 
@@ -19,7 +30,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pb_warn.h"
+
 #define PB_DBC_MAX_FILE (64u << 20)
+#define PSEUDO_MESSAGE "VECTOR__INDEPENDENT_SIG_MSG"
+#define PSEUDO_MAX 8 /* distinct pseudo-message identifiers remembered */
 
 /* ---- arena ------------------------------------------------------------ */
 
@@ -61,6 +76,16 @@ typedef struct parser {
     /* scratch for VAL_ and SG_MUL_VAL_ lists before they move to the arena */
     void *scratch;
     size_t scratch_cap;
+    /* VECTOR__INDEPENDENT_SIG_MSG: set while its SG_ lines follow; its
+     * identifiers; the names of its signals so far (pointers into the text). */
+    int in_pseudo;
+    uint64_t pseudo_raw[PSEUDO_MAX];
+    size_t pseudo_raw_count;
+    struct pseudo_signal {
+        const char *s;
+        size_t n, line;
+    } *pseudo_sigs;
+    size_t pseudo_sig_count, pseudo_sig_cap;
 } parser;
 
 #if defined(__GNUC__)
@@ -85,14 +110,14 @@ __attribute__((format(printf, 3, 4)))
 #endif
 static void warn_at(parser *ps, size_t line, const char *fmt, ...)
 {
-    if (ps->dbc->warning_count++ == 0) {
-        char what[200];
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(what, sizeof what, fmt, ap);
-        va_end(ap);
+    char what[200];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    if (ps->dbc->warning_count++ == 0)
         snprintf(ps->dbc->warning, sizeof ps->dbc->warning, "%s:%zu: %s", ps->name, line, what);
-    }
+    pb_warn("%s:%zu: %s", ps->name, line, what);
 }
 
 static void *arena_alloc(parser *ps, size_t size)
@@ -402,6 +427,14 @@ static int find_signal(const pb_dbc_message *m, const token *t)
     return -1;
 }
 
+static int is_pseudo_raw(const parser *ps, uint64_t raw)
+{
+    for (size_t i = 0; i < ps->pseudo_raw_count; i++)
+        if (ps->pseudo_raw[i] == raw)
+            return 1;
+    return 0;
+}
+
 static void parse_bo(parser *ps, size_t line)
 {
     uint64_t raw = expect_uint(ps, 0xffffffffu, "a message identifier");
@@ -410,6 +443,18 @@ static void parse_bo(parser *ps, size_t line)
     uint64_t size = expect_uint(ps, 64, "a message size (0..64)");
     token sender = expect_kind(ps, T_IDENT, "a sender node");
     skip_line(ps, sender.line);
+
+    ps->in_pseudo = tok_is(&name, PSEUDO_MESSAGE);
+    if (ps->in_pseudo) {
+        /* Dropped, as cantools drops it; its signals are checked in parse_sg. */
+        if (!is_pseudo_raw(ps, raw) && ps->pseudo_raw_count < PSEUDO_MAX)
+            ps->pseudo_raw[ps->pseudo_raw_count++] = raw;
+        ps->pseudo_sig_count = 0;
+        return;
+    }
+    if ((raw & 0x7fffffffu) > 0x1fffffffu)
+        fail_at(ps, line, "identifier %llu of message %.*s exceeds 29 bits (only " PSEUDO_MESSAGE " may)",
+                (unsigned long long)raw, (int)(name.n > 64 ? 64 : name.n), name.s);
 
     pb_dbc *d = ps->dbc;
     if (d->message_count == ps->cap_messages) {
@@ -444,10 +489,11 @@ static void parse_bo(parser *ps, size_t line)
 static void parse_sg(parser *ps, size_t line)
 {
     pb_dbc *d = ps->dbc;
-    if (d->message_count == 0)
+    const int pseudo = ps->in_pseudo;
+    if (d->message_count == 0 && !pseudo)
         fail_at(ps, line, "SG_ outside a message (no BO_ before it)");
-    const size_t mi = d->message_count - 1;
-    pb_dbc_message *m = &d->messages[mi];
+    const size_t mi = pseudo ? 0 : d->message_count - 1;
+    pb_dbc_message *m = pseudo ? NULL : &d->messages[mi];
 
     token name = expect_kind(ps, T_IDENT, "a signal name");
     int is_mux = 0, has_mux_value = 0;
@@ -514,6 +560,28 @@ static void parse_sg(parser *ps, size_t line)
     if (last >= 512)
         fail_at(ps, line, "signal %.*s (start %u, length %u) runs past 64 bytes", (int)name.n, name.s,
                 (unsigned)start, (unsigned)length);
+    if (pseudo) {
+        for (size_t i = 0; i < ps->pseudo_sig_count; i++) {
+            const struct pseudo_signal *o = &ps->pseudo_sigs[i];
+            if (o->n == name.n && memcmp(o->s, name.s, name.n) == 0) {
+                warn_at(ps, line,
+                        "signal %.*s repeats in " PSEUDO_MESSAGE " (first at line %zu); that pseudo-message "
+                        "of signals in no message is skipped, as cantools skips it",
+                        (int)(name.n > 64 ? 64 : name.n), name.s, o->line);
+                return;
+            }
+        }
+        if (ps->pseudo_sig_count == ps->pseudo_sig_cap) {
+            size_t cap = ps->pseudo_sig_cap ? ps->pseudo_sig_cap * 2 : 32;
+            struct pseudo_signal *n = realloc(ps->pseudo_sigs, cap * sizeof *n);
+            if (!n)
+                fail_at(ps, line, "out of memory");
+            ps->pseudo_sigs = n;
+            ps->pseudo_sig_cap = cap;
+        }
+        ps->pseudo_sigs[ps->pseudo_sig_count++] = (struct pseudo_signal){name.s, name.n, line};
+        return;
+    }
     if (last / 8 + 1 > m->size)
         warn_at(ps, line, "signal %.*s runs past its message's %u bytes", (int)name.n, name.s,
                 m->size);
@@ -578,6 +646,8 @@ static void parse_val(parser *ps, size_t line)
         c[n].text = arena_str(ps, &text);
         n++;
     }
+    if (is_pseudo_raw(ps, raw))
+        return;
     pb_dbc_message *m = find_message_raw(ps, raw);
     int si = m ? find_signal(m, &sig) : -1;
     if (si < 0) {
@@ -601,6 +671,8 @@ static void parse_sig_valtype(parser *ps, size_t line)
         next(ps);
     uint64_t type = expect_uint(ps, 3, "a value type (0..3)");
     expect_punct(ps, ';');
+    if (is_pseudo_raw(ps, raw))
+        return;
     pb_dbc_message *m = find_message_raw(ps, raw);
     int si = m ? find_signal(m, &sig) : -1;
     if (si < 0) {
@@ -640,6 +712,8 @@ static void parse_sg_mul_val(parser *ps, size_t line)
         if (t.kind != T_PUNCT || t.s[0] != ',')
             fail_at(ps, t.line, "expected ',' or ';' in SG_MUL_VAL_");
     }
+    if (is_pseudo_raw(ps, raw))
+        return;
     pb_dbc_message *m = find_message_raw(ps, raw);
     int si = m ? find_signal(m, &sig) : -1;
     int mi = m ? find_signal(m, &mux) : -1;
@@ -712,7 +786,7 @@ static void build_index(parser *ps)
     size_t n = 0;
     for (size_t i = 0; i < d->message_count; i++) {
         const pb_dbc_message *m = &d->messages[i];
-        if (m->id > 0x1fffffff) /* pseudo messages such as VECTOR__INDEPENDENT_SIG_MSG */
+        if (m->id > 0x1fffffff) /* cannot happen: parse_bo refuses such identifiers */
             continue;
         d->index[n].key = m->id | (uint32_t)m->extended << 31;
         d->index[n].message = (uint32_t)i;
@@ -755,6 +829,8 @@ static void parse_ba(parser *ps, size_t line)
     uint64_t raw = expect_uint(ps, 0xffffffffu, "a message identifier");
     double ms = expect_double(ps);
     expect_punct(ps, ';');
+    if (is_pseudo_raw(ps, raw))
+        return;
     pb_dbc_message *m = find_message_raw(ps, raw);
     if (!m) {
         warn_at(ps, line, "GenMsgCycleTime for unknown message %llu", (unsigned long long)raw);
@@ -848,6 +924,7 @@ int pb_dbc_parse(const char *text, size_t len, const char *name, pb_dbc **out, p
     }
     free(ps->cap_signals);
     free(ps->scratch);
+    free(ps->pseudo_sigs);
     free(ps);
     return rc;
 }
