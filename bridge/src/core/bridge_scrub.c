@@ -120,7 +120,8 @@ static pose_status clip_to(pose_bridge *b, double t_s, pb_error *err)
 {
     pb_scrub *s = &b->scrub;
     double end = pb_player_duration(&s->player);
-    if (t_s > end + 1e-9)
+    /* The bridge thread's last tick is the first one past the end (showing the last frame). */
+    if (t_s > end + b->period + 1e-9)
         return pb_fail(err, POSE_ERR_INVALID_ARGUMENT, "%s: %.3f s is past the end of the clip (%.3f s)",
                        b->clip->path, t_s, end);
     /* Ticks accumulate as the runner's do (next += period), so their times match to the bit. */
@@ -164,6 +165,9 @@ static pose_status device_to(pose_bridge *b, double t_s, pb_error *err)
         } else {
             int got = pb_source_read(s->src, &u, 1000);
             if (got <= 0) {
+                /* The last sample's own time is the recording's end, not past it. */
+                if (s->src->state == PB_SOURCE_ENDED && s->last_t >= 0 && want <= s->last_t + 1000)
+                    break;
                 if (s->src->state == PB_SOURCE_ENDED || ++misses > 10000)
                     return pb_fail(err, POSE_ERR_INVALID_ARGUMENT,
                                    "%s: %.3f s is past the end of the recording (%.3f s)", b->spec.target, t_s,

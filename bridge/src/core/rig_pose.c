@@ -2,6 +2,7 @@
  * The bridge's only contact with a live pose_rig / pose_state: reading the
  * rig's skeleton, and applying a pose. Kept apart so that everything else
  * in the bridge links without libpose. */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -34,6 +35,19 @@ pose_status pb_rig_skel_from_rig(const pose_rig *rig, pb_rig_skel **out, pb_erro
     }
     pose_status s = pb_rig_skel_from_desc(d, n, out, err);
     free(d);
+    /* The neutral posture and clinical axes, where the rig has them (mappings' "dof"). */
+    for (size_t j = 0; s == POSE_OK && j < n; j++) {
+        pb_rig_joint *R = &(*out)->joints[j];
+        if (pose_rig_joint_clinical(rig, (int)j, &R->clinical) != POSE_OK) {
+            memset(&R->clinical, 0, sizeof R->clinical);
+            continue;
+        }
+        for (int k = 0; k < 3; k++) {
+            snprintf(R->clinical_names[k], sizeof R->clinical_names[k], "%s",
+                     R->clinical.names[k] ? R->clinical.names[k] : "");
+            R->clinical.names[k] = R->clinical_names[k];
+        }
+    }
     return s;
 }
 
