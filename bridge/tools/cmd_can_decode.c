@@ -23,7 +23,8 @@ static void help(FILE *f)
                "  --bus FILE   a bus description (a mapping file's \"can\" object): DBC signals,\n"
                "               CANopen CiA 406/410 nodes and J1939 slope sensors as channels\n"
                "  LOG          a candump -l log\n"
-               "  --json       {\"t\":..,\"id\":..,\"msg\":..,\"signals\":{..}} per line\n"
+               "  --json       {\"t\":..,\"id\":..,\"msg\":..,\"signals\":{..}} per line, after a line\n"
+               "               {\"warnings\":[..]} when the DBC raised warnings (also on stderr)\n"
                "  --all        also list frames nothing decodes (id only)\n"
                "Signals a multiplexor switches off and signals past a short frame's end are\n"
                "left out of the frame's line; short frames and malformed lines are counted on\n"
@@ -88,7 +89,10 @@ static int run(int argc, char **argv)
     }
     pb_error err;
     pb_can_bus *bus = NULL;
+    static pb_warnings warnings;
+    pb_cli_warnings_begin(&warnings);
     pose_status st = bus_path ? pb_can_bus_load(bus_path, &bus, &err) : pb_can_bus_create(dbc_path, &bus, &err);
+    pb_warnings_install(NULL);
     if (st != POSE_OK) {
         fprintf(stderr, "pose-bridge can-decode: %s\n", err.message);
         return 1;
@@ -100,8 +104,8 @@ static int run(int argc, char **argv)
         return 1;
     }
     const pb_dbc *dbc = pb_can_bus_dbc(bus);
-    if (dbc && dbc->warning_count)
-        fprintf(stderr, "pose-bridge can-decode: %zu DBC warning(s), first: %s\n", dbc->warning_count, dbc->warning);
+    if (json)
+        pb_cli_json_warnings_line(stdout, &warnings);
     pb_candump_reader r;
     char msg[256];
     if (pb_candump_open(&r, log, msg, sizeof msg) != 0) {

@@ -28,7 +28,8 @@ static void help(FILE *f)
                "  IFACE       SocketCAN interface to watch\n"
                "  --log FILE  replay a candump -l log as the bus (recorded timing; --fast: at once)\n"
                "  --bus FILE  bus description (a mapping file's \"can\" object)\n"
-               "  --json      one JSON object per report\n"
+               "  --json      one JSON object per report, after a line {\"warnings\":[..]} when the\n"
+               "              DBC raised warnings (also on stderr)\n"
                "  --seconds S stop after S seconds of bus time\n"
                "Every second of bus time: the source state, the controller state, and per node\n"
                "its state (alive, silent, never seen), frames per second and CANopen NMT state.\n");
@@ -113,10 +114,16 @@ static int run(int argc, char **argv)
     }
     pb_error err;
     pb_can_bus *bus = NULL;
-    if (pb_can_bus_load(bus_path, &bus, &err) != POSE_OK) {
+    static pb_warnings warnings;
+    pb_cli_warnings_begin(&warnings);
+    pose_status loaded = pb_can_bus_load(bus_path, &bus, &err);
+    pb_warnings_install(NULL);
+    if (loaded != POSE_OK) {
         fprintf(stderr, "pose-bridge can-monitor: %s\n", err.message);
         return 1;
     }
+    if (json)
+        pb_cli_json_warnings_line(stdout, &warnings);
     pb_source *src = NULL;
     pose_status st;
     if (log) {

@@ -62,15 +62,14 @@ static const char *type_name(const pb_dbc_signal *s)
                                            : "unsigned";
 }
 
+static pb_warnings warnings; /* what the parser warned about, file:line each */
+
 static void describe_json(const pb_dbc *d)
 {
     printf("{\"file\":");
     json_text(d->path);
-    printf(",\"warnings\":%zu", d->warning_count);
-    if (d->warning_count) {
-        printf(",\"first_warning\":");
-        json_text(d->warning);
-    }
+    printf(",\"warning_count\":%zu,", d->warning_count);
+    pb_cli_json_warnings(stdout, &warnings);
     printf(",\"messages\":[");
     for (size_t i = 0; i < d->message_count; i++) {
         const pb_dbc_message *m = &d->messages[i];
@@ -123,9 +122,8 @@ static void describe_json(const pb_dbc *d)
 
 static void describe_text(const pb_dbc *d)
 {
-    printf("%s: %zu messages, %zu warnings\n", d->path, d->message_count, d->warning_count);
-    if (d->warning_count)
-        printf("  first warning: %s\n", d->warning);
+    printf("%s: %zu messages, %zu warnings%s\n", d->path, d->message_count, d->warning_count,
+           d->warning_count ? " (on stderr)" : "");
     for (size_t i = 0; i < d->message_count; i++) {
         const pb_dbc_message *m = &d->messages[i];
         printf("%s 0x%0*X (%u) %u bytes%s", m->name, m->extended ? 8 : 3, (unsigned)m->id, (unsigned)m->id,
@@ -177,7 +175,10 @@ static int run(int argc, char **argv)
     }
     pb_dbc *d = NULL;
     pb_dbc_error err;
-    if (pb_dbc_load(file, &d, &err) != 0) {
+    pb_cli_warnings_begin(&warnings);
+    int loaded = pb_dbc_load(file, &d, &err);
+    pb_warnings_install(NULL);
+    if (loaded != 0) {
         fprintf(stderr, "pose-bridge dbc-describe: %s\n", err.message);
         return 1;
     }

@@ -14,7 +14,8 @@ static void usage(FILE *f)
     fprintf(f, "usage: pose-bridge hid-decode RECORDING.hid [--device N] [--limit N] [--json]\n"
                "Decodes every E: line with its device's report descriptor. --json prints one object\n"
                "per event: {\"t\": s, \"device\": n, \"report_id\": id, \"values\": {channel: {\"logical\": v,\n"
-               "\"physical\": p}}} or {\"t\": s, \"device\": n, \"line\": l, \"error\": text}.\n");
+               "\"physical\": p}}} or {\"t\": s, \"device\": n, \"line\": l, \"error\": text}; a first line\n"
+               "{\"warnings\": [text, ...]} when the descriptors raised warnings (also printed on stderr).\n");
 }
 
 static void print_event(const pb_hid_desc *d, const pb_hid_rec_event *e, const uint8_t *bytes, int json,
@@ -89,10 +90,13 @@ static int run(int argc, char **argv)
         usage(stderr);
         return 2;
     }
+    static pb_warnings warnings;
+    pb_cli_warnings_begin(&warnings);
     pb_hid_recording *rec;
     pb_error err;
     if (pb_hid_recording_load(path, &rec, &err) != POSE_OK) {
         fprintf(stderr, "pose-bridge hid-decode: %s\n", err.message);
+        pb_warnings_install(NULL);
         return 1;
     }
     int rc = 0;
@@ -116,6 +120,9 @@ static int run(int argc, char **argv)
         fprintf(stderr, "pose-bridge hid-decode: out of memory\n");
         rc = 1;
     }
+    pb_warnings_install(NULL);
+    if (json && rc == 0)
+        pb_cli_json_warnings_line(stdout, &warnings);
     long shown = 0;
     for (size_t i = 0; rc == 0 && i < rec->event_count && (limit < 0 || shown < limit); i++) {
         const pb_hid_rec_event *e = &rec->events[i];

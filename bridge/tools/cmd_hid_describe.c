@@ -39,6 +39,8 @@ static int channel_of(const pb_hid_desc *d, size_t field)
     return -1;
 }
 
+static pb_warnings warnings; /* what parsing the descriptor warned about */
+
 static void print_json(const char *origin, const pb_hid_rec_device *info, const pb_hid_desc *d, size_t desc_len)
 {
     printf("{\"source\":");
@@ -101,7 +103,9 @@ static void print_json(const char *origin, const pb_hid_rec_device *info, const 
             printf(",\"min\":%.9g,\"max\":%.9g", ch->min, ch->max);
         printf("}");
     }
-    printf("]}\n");
+    printf("],");
+    pb_cli_json_warnings(stdout, &warnings);
+    printf("}\n");
 }
 
 static void print_text(const char *origin, const pb_hid_rec_device *info, const pb_hid_desc *d, size_t desc_len)
@@ -241,14 +245,20 @@ static int run(int argc, char **argv)
         usage(stderr);
         return 2;
     }
-    if (!pb_hid_spec_is_live(spec))
-        return describe_file(spec, device, json);
+    pb_cli_warnings_begin(&warnings);
+    if (!pb_hid_spec_is_live(spec)) {
+        int rc = describe_file(spec, device, json);
+        pb_warnings_install(NULL);
+        return rc;
+    }
     pb_source *src;
     pb_error err;
     if (pb_hid_open(spec, NULL, &src, &err) != POSE_OK) {
         fprintf(stderr, "pose-bridge hid-describe: %s\n", err.message);
+        pb_warnings_install(NULL);
         return 1;
     }
+    pb_warnings_install(NULL);
     size_t len;
     pb_hid_source_desc_bytes(src, &len);
     if (json)

@@ -68,7 +68,11 @@ static int run(int argc, char **argv)
     pb_hid_replay_options opt = {.as_fast_as_possible = fast};
     pb_source *src;
     pb_error err;
-    if (pb_hid_open(spec, &opt, &src, &err) != POSE_OK) {
+    static pb_warnings warnings;
+    pb_cli_warnings_begin(&warnings);
+    pose_status opened = pb_hid_open(spec, &opt, &src, &err);
+    pb_warnings_install(NULL);
+    if (opened != POSE_OK) {
         fprintf(stderr, "pose-bridge hid-record: %s\n", err.message);
         return 1;
     }
@@ -123,9 +127,11 @@ static int run(int argc, char **argv)
     if (json) {
         printf("{\"output\":");
         pb_cli_json_string(stdout, out_path);
-        printf(",\"reports\":%llu,\"bad_reports\":%llu,\"unknown_ids\":%llu,\"disconnects\":%llu}\n",
+        printf(",\"reports\":%llu,\"bad_reports\":%llu,\"unknown_ids\":%llu,\"disconnects\":%llu,",
                (unsigned long long)st.reports, (unsigned long long)st.bad_reports,
                (unsigned long long)st.unknown_ids, (unsigned long long)st.disconnects);
+        pb_cli_json_warnings(stdout, &warnings);
+        printf("}\n");
     } else
         printf("%s: %llu reports recorded\n", out_path, (unsigned long long)st.reports);
     return rc;

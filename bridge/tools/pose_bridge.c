@@ -37,6 +37,35 @@ void pb_cli_json_string(FILE *f, const char *s)
     fputc('"', f);
 }
 
+void pb_cli_warnings_begin(pb_warnings *w)
+{
+    memset(w, 0, sizeof *w);
+    w->echo = 1;
+    pb_warnings_install(w);
+}
+
+void pb_cli_json_warnings(FILE *f, const pb_warnings *w)
+{
+    fputs("\"warnings\":[", f);
+    for (size_t i = 0; w && i < w->count; i++) {
+        if (i)
+            fputc(',', f);
+        pb_cli_json_string(f, w->text[i]);
+    }
+    fputc(']', f);
+    if (w && w->dropped)
+        fprintf(f, ",\"warnings_dropped\":%zu", w->dropped);
+}
+
+void pb_cli_json_warnings_line(FILE *f, const pb_warnings *w)
+{
+    if (!w || (w->count == 0 && w->dropped == 0))
+        return;
+    fputc('{', f);
+    pb_cli_json_warnings(f, w);
+    fputs("}\n", f);
+}
+
 static void usage(FILE *f)
 {
     fprintf(f, "usage: pose-bridge <command> [options]   (pose-bridge <command> --help)\n\ncommands:\n");

@@ -8,6 +8,8 @@
 
 #include <stdio.h>
 
+#include "pb_warn.h"
+
 typedef struct pb_command {
     const char *name;    /**< as typed: "fk", "replay", "hid-describe" ... */
     const char *summary; /**< one line for `pose-bridge --help` */
@@ -22,5 +24,18 @@ extern const pb_command *const pb_commands[];
 int pb_cli_wants_help(int argc, char **argv);
 /** Write `s` as a JSON string literal (quotes and escapes) to f. */
 void pb_cli_json_string(FILE *f, const char *s);
+
+/**
+ * Warnings from the files a subcommand loads (a HID descriptor's trailing
+ * 0x00, a DBC's repeated pseudo-message signals ...): each subcommand that
+ * parses descriptors or DBCs installs a sink with pb_cli_warnings_begin (echo
+ * on: each warning is printed on stderr as it comes) and lists them in its
+ * --json output with pb_cli_json_warnings.
+ */
+void pb_cli_warnings_begin(pb_warnings *w);
+/** Write `"warnings":[...]` (key included; `,"warnings_dropped":N` after it when some were not kept). */
+void pb_cli_json_warnings(FILE *f, const pb_warnings *w);
+/** For line-per-record JSON outputs: one line {"warnings":[...]} when there are any. */
+void pb_cli_json_warnings_line(FILE *f, const pb_warnings *w);
 
 #endif /* POSE_BRIDGE_CLI_H */
