@@ -81,6 +81,7 @@ typedef struct bake_state {
     float **emb_bary;
     float *cor;
     pose_joint_desc *joints;
+    pose_joint_clinical *clinical; /* NULL when the template has no clinical data */
     pose_tissue_desc *tissues;
 } bake_state;
 
@@ -111,6 +112,7 @@ static void bake_state_free(bake_state *s, const pp_bake_options *o, size_t tiss
     free(s->emb_bary);
     free(s->cor);
     free(s->joints);
+    free(s->clinical);
     free(s->tissues);
 }
 
@@ -236,6 +238,30 @@ static int build_tissues(const pp_bake_options *o, bake_state *s, pp_bake_report
     return POSE_OK;
 }
 
+/* The rig's clinical section from the bake's clinical fit (none when the
+ * template has no "clinical" object), and a note for the metadata naming
+ * the largest neutral offset. Returns the number of joints with clinical
+ * data, or -1 when out of memory. */
+static int clinical_desc(const pp_bake_report *rep, bake_state *s, char *note, size_t note_size)
+{
+    size_t nj = rep->tmpl.joint_count, count = 0, big = 0;
+    for (size_t j = 0; j < nj; j++)
+        if ((rep->clinical[j].c.flags & POSE_CLINICAL_DEFINED) &&
+            (count++ == 0 || rep->clinical[j].neutral_deg > rep->clinical[big].neutral_deg))
+            big = j;
+    if (count == 0)
+        return 0;
+    s->clinical = calloc(nj, sizeof *s->clinical);
+    if (!s->clinical)
+        return -1;
+    for (size_t j = 0; j < nj; j++)
+        s->clinical[j] = rep->clinical[j].c;
+    snprintf(note, note_size,
+             "; neutral posture and clinical axes for %zu joints (largest neutral offset %s %.1f deg)",
+             count, rep->tmpl.joints[big].name, rep->clinical[big].neutral_deg);
+    return (int)count;
+}
+
 static int write_rig(const pp_bake_options *o, bake_state *s, pp_bake_report *rep, char *err,
                      size_t n)
 {
@@ -256,18 +282,21 @@ static int write_rig(const pp_bake_options *o, bake_state *s, pp_bake_report *re
         memcpy(d->limit_min_deg, tj->limit_min_deg, sizeof d->limit_min_deg);
         memcpy(d->limit_max_deg, tj->limit_max_deg, sizeof d->limit_max_deg);
     }
-    char meta[1024];
+    char meta[1024], neutral[256] = "";
+    int clinical = clinical_desc(rep, s, neutral, sizeof neutral);
+    if (clinical < 0)
+        return pp_fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
     snprintf(meta, sizeof meta,
              "pose-bake %s; template %s (%s); skin %s; %zu bones; voxel %.2f mm; backend %s; "
-             "K %u; %zu tet vertices, %zu tets",
+             "K %u; %zu tet vertices, %zu tets%s",
              pose_version_string(), t->name, o->template_path, o->skin_path, o->bone_count,
              (double)rep->voxel_mm, pp_tet_backend_name(o->backend), s->w.influences,
-             s->tet.vertex_count, s->tet.tet_count);
+             s->tet.vertex_count, s->tet.tet_count, neutral);
     pose_rig_desc desc = {t->joint_count,     s->joints,     s->tet.vertex_count,
                           s->tet.positions,   s->tet.tet_count, s->tet.tets,
                           s->tet.labels,      s->w.influences, s->w.joints,
                           s->w.weights,       s->cor,        rep->tissue_count,
-                          s->tissues,         meta,          NULL};
+                          s->tissues,         meta,          s->clinical};
     /* Write beside the target, then rename: a reader never sees half a rig. */
     size_t len = strlen(o->output_path) + 32;
     char *tmp = malloc(len);
@@ -333,6 +362,14 @@ int pp_bake(const pp_bake_options *o, pp_bake_report *rep, char *err, size_t n)
         goto done;
     }
     rc = pp_rig_fit(&rep->tmpl, s.bones, o->bone_count, rep->fits, err, n);
+    if (rc < 0)
+        goto done;
+    rep->clinical = calloc(rep->tmpl.joint_count, sizeof *rep->clinical);
+    if (!rep->clinical) {
+        rc = pp_fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+        goto done;
+    }
+    rc = pp_clinical_fit(&rep->tmpl, rep->fits, rep->clinical, err, n);
     if (rc < 0)
         goto done;
     stage_end(&clk);
@@ -415,6 +452,7 @@ void pp_bake_report_free(pp_bake_report *r)
         return;
     pp_template_free(&r->tmpl);
     free(r->fits);
+    free(r->clinical);
     free(r->tissues);
     memset(r, 0, sizeof *r);
 }

@@ -9,6 +9,7 @@
 #ifndef POSE_PP_BAKE_PIPELINE_H
 #define POSE_PP_BAKE_PIPELINE_H
 
+#include "clinical_fit.h"
 #include "cor_fast.h"
 #include "embed_hash.h"
 #include "rig_fit.h"
@@ -72,6 +73,7 @@ typedef struct pp_bake_report {
     double peak_rss_mb;
     pp_template tmpl;              /**< the template used (names, rules) */
     pp_fit_joint *fits;            /**< tmpl.joint_count */
+    pp_clinical_joint *clinical;   /**< tmpl.joint_count: neutral posture and clinical axes */
     pp_voxel_report voxels;
     float voxel_mm;
     pp_tet_quality quality;

@@ -58,6 +58,16 @@ char *pp_bake_report_json(const pp_bake_report *r, const pp_bake_options *o)
         cJSON_AddNumberToObject(o2, "contact_points", (double)f->contact_points);
         cJSON_AddNumberToObject(o2, "radius_mm", round(f->radius_mm * 100) / 100);
         cJSON_AddNumberToObject(o2, "residual_mm", round(f->residual_mm * 100) / 100);
+        const pp_clinical_joint *cl = r->clinical ? &r->clinical[j] : NULL;
+        if (cl && (cl->c.flags & POSE_CLINICAL_DEFINED)) {
+            /* The neutral posture's offset from rest, and the axes (model
+             * space, neutral posture) the clinical angles turn about. */
+            cJSON_AddNumberToObject(o2, "neutral_offset_deg", round(cl->neutral_deg * 100) / 100);
+            cJSON *ax = cJSON_AddObjectToObject(o2, "clinical_axes");
+            static const char *keys[3] = {"flexion", "abduction", "rotation"};
+            for (int k = 0; k < 3; k++)
+                add_vec(ax, keys[k], cl->model_axes[k], 3);
+        }
         cJSON_AddItemToArray(joints, o2);
     }
 

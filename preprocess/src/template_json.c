@@ -214,6 +214,116 @@ static int parse_limits(const parse_ctx *c, const char *joint, const cJSON *lim,
     return POSE_OK;
 }
 
+static double angle_deg(const float a[3], const float b[3])
+{
+    double d = (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2];
+    return acos(fmax(-1.0, fmin(1.0, d))) * 57.29577951308232; /* degrees per radian */
+}
+
+/* Nominal directions that are not roughly perpendicular are a typo (a sign
+ * or an axis swapped): the bake could not tell which way was meant. */
+static int check_perpendicular(const parse_ctx *c, const char *joint, const char *ka, const float *a,
+                               const char *kb, const float *b)
+{
+    double deg = angle_deg(a, b);
+    if (deg < 60.0 || deg > 120.0)
+        return fail_at(c, POSE_ERR_INVALID_DATA, joint,
+                       "'clinical.%s' and 'clinical.%s' are %.0f degrees apart; they must be roughly "
+                       "perpendicular (60..120)",
+                       ka, kb, deg);
+    return POSE_OK;
+}
+
+static int parse_clinical_limits(const parse_ctx *c, const char *joint, const cJSON *lim,
+                                 pp_template_clinical *k)
+{
+    static const char *keys[3] = {"flexion", "abduction", "rotation"};
+    if (!cJSON_IsObject(lim))
+        return fail_at(c, POSE_ERR_FORMAT, joint, "'clinical.limits' must be an object");
+    if (repeated_key(lim))
+        return fail_at(c, POSE_ERR_FORMAT, joint, "key 'clinical.limits.%s' appears twice",
+                       repeated_key(lim));
+    for (const cJSON *e = lim->child; e; e = e->next) {
+        int a = -1;
+        for (int i = 0; i < 3; i++)
+            if (strcmp(e->string, keys[i]) == 0)
+                a = i;
+        if (a < 0)
+            return fail_at(c, POSE_ERR_FORMAT, joint,
+                           "unknown key 'clinical.limits.%s' (expected flexion, abduction, rotation)",
+                           e->string);
+        float mm[2];
+        if (!read_vec(e, mm, 2) || mm[0] > mm[1] || mm[0] < -180.0f || mm[1] > 180.0f)
+            return fail_at(c, POSE_ERR_FORMAT, joint,
+                           "'clinical.limits.%s' must be [min, max] degrees with -180 <= min <= max <= 180",
+                           e->string);
+        k->limit_flags |= 1u << a;
+        k->limit_min_deg[a] = mm[0];
+        k->limit_max_deg[a] = mm[1];
+    }
+    return POSE_OK;
+}
+
+static int parse_clinical(const parse_ctx *c, const char *joint, const cJSON *obj,
+                          pp_template_clinical *k)
+{
+    if (!cJSON_IsObject(obj))
+        return fail_at(c, POSE_ERR_FORMAT, joint, "'clinical' must be an object");
+    if (repeated_key(obj))
+        return fail_at(c, POSE_ERR_FORMAT, joint, "key 'clinical.%s' appears twice", repeated_key(obj));
+    int have_flex = 0, have_abd = 0;
+    for (const cJSON *e = obj->child; e; e = e->next) {
+        const char *key = e->string;
+        if (strcmp(key, "neutral") == 0) {
+            if (!read_unit_vec(e, k->neutral))
+                return fail_at(c, POSE_ERR_FORMAT, joint, "'clinical.neutral' must be a non-zero [x, y, z]");
+            k->has_neutral = 1;
+        } else if (strcmp(key, "flexion") == 0 || strcmp(key, "abduction") == 0) {
+            int flex = key[0] == 'f';
+            if (!read_unit_vec(e, flex ? k->flexion : k->abduction))
+                return fail_at(c, POSE_ERR_FORMAT, joint, "'clinical.%s' must be a non-zero [x, y, z]", key);
+            have_flex |= flex;
+            have_abd |= !flex;
+        } else if (strcmp(key, "rotation") == 0) {
+            if (!cJSON_IsNumber(e) || (e->valuedouble != 1.0 && e->valuedouble != -1.0))
+                return fail_at(c, POSE_ERR_FORMAT, joint,
+                               "'clinical.rotation' must be 1 (positive rotation right-handed about "
+                               "the distal direction) or -1 (about the proximal one)");
+            k->rotation_sign = (int)e->valuedouble;
+        } else if (strcmp(key, "names") == 0) {
+            if (!cJSON_IsArray(e) || cJSON_GetArraySize(e) != 3)
+                return fail_at(c, POSE_ERR_FORMAT, joint,
+                               "'clinical.names' must be 3 names (flexion, abduction, rotation)");
+            int i = 0;
+            for (const cJSON *n = e->child; n; n = n->next, i++) {
+                if (!cJSON_IsString(n) || strlen(n->valuestring) < 1 ||
+                    strlen(n->valuestring) >= PP_CLINICAL_NAME_MAX)
+                    return fail_at(c, POSE_ERR_FORMAT, joint,
+                                   "'clinical.names' entry %d must be a string of 1..%d bytes", i,
+                                   PP_CLINICAL_NAME_MAX - 1);
+                strcpy(k->names[i], n->valuestring);
+            }
+        } else if (strcmp(key, "limits") == 0) {
+            int rc = parse_clinical_limits(c, joint, e, k);
+            if (rc < 0)
+                return rc;
+        } else if (strcmp(key, "comment") != 0) {
+            return fail_at(c, POSE_ERR_FORMAT, joint, "unknown key 'clinical.%s'", key);
+        }
+    }
+    if (!have_flex || !have_abd || k->rotation_sign == 0)
+        return fail_at(c, POSE_ERR_FORMAT, joint, "'clinical' needs 'flexion', 'abduction' and 'rotation'");
+    int rc = check_perpendicular(c, joint, "flexion", k->flexion, "abduction", k->abduction);
+    if (rc >= 0 && k->has_neutral)
+        rc = check_perpendicular(c, joint, "neutral", k->neutral, "flexion", k->flexion);
+    if (rc >= 0 && k->has_neutral)
+        rc = check_perpendicular(c, joint, "neutral", k->neutral, "abduction", k->abduction);
+    if (rc < 0)
+        return rc;
+    k->defined = 1;
+    return POSE_OK;
+}
+
 static int parse_joint(const parse_ctx *c, const cJSON *obj, size_t index, pp_template *t,
                        float default_contact_mm)
 {
@@ -298,6 +408,8 @@ static int parse_joint(const parse_ctx *c, const cJSON *obj, size_t index, pp_te
             j->has_at = 1;
         } else if (strcmp(key, "limits") == 0) {
             rc = parse_limits(c, jn, e, j);
+        } else if (strcmp(key, "clinical") == 0) {
+            rc = parse_clinical(c, jn, e, &j->clinical);
         } else if (strcmp(key, "comment") == 0) {
             continue;
         } else {
@@ -314,6 +426,9 @@ static int parse_joint(const parse_ctx *c, const cJSON *obj, size_t index, pp_te
         return fail_at(c, POSE_ERR_INVALID_DATA, jn,
                        j->parent < 0 ? "a joint without parent must have rule 'root'"
                                      : "rule 'root' is only for a joint without parent");
+    if (j->parent < 0 && j->clinical.defined)
+        return fail_at(c, POSE_ERR_INVALID_DATA, jn,
+                       "the root has no clinical angles ('clinical'); pose_set_root places the body");
     if (j->rule == PP_FIT_FIXED && !j->has_at)
         return fail_at(c, POSE_ERR_FORMAT, jn, "rule 'fixed' needs 'at'");
     for (size_t k = 0; k < j->contact_count; k++)

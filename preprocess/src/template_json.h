@@ -19,8 +19,25 @@
  *       "axis": [0, 1, 0], "up": [0, 0, 1], approximate frame y and z (model space)
  *       "at": [x, y, z],                    fixed centre (rule fixed; root optional)
  *       "limits": {"order": "XYZ", "y": [0, 150]},  degrees about frame axes
+ *       "clinical": { ... },                optional, see below (not on the root)
  *       "comment": "..." } ] }
  * Unknown or repeated keys are errors, so typos do not pass silently.
+ *
+ * "clinical" describes the joint's clinical angles (design §2b, pose.h
+ * pose_joint_clinical) in model space, in the anatomical neutral posture:
+ *   { "neutral": [0, 0, -1],     optional: direction the segment (this joint ->
+ *                                its child joint) points in the neutral posture;
+ *                                absent: the rest pose is neutral for this joint
+ *     "flexion": [0, -1, 0],     nominal axis of positive flexion (right-handed)
+ *     "abduction": [-1, 0, 0],   nominal axis of positive abduction
+ *     "rotation": -1,            +1: positive rotation is right-handed about the
+ *                                distal direction, -1: about the proximal one
+ *     "names": ["flexion", "abduction", "internal_rotation"],  optional, 1..31 bytes
+ *     "limits": {"flexion": [-60, 180], "abduction": [-30, 180], "rotation": [-90, 70]},
+ *     "comment": "..." }
+ * pose-bake turns these into the rig's neutral offset and axes from the
+ * fitted joints (clinical_fit.h); the vectors are nominal, so they need only
+ * say which way, and a hinge's flexion axis comes from the bones.
  */
 #ifndef POSE_PP_TEMPLATE_JSON_H
 #define POSE_PP_TEMPLATE_JSON_H
@@ -48,6 +65,21 @@ typedef enum pp_fit_side {
     PP_SIDE_BOTH = 2,   /**< both articular surfaces */
 } pp_fit_side;
 
+#define PP_CLINICAL_NAME_MAX 32
+
+/** A joint's "clinical" object (model space, neutral posture). */
+typedef struct pp_template_clinical {
+    int defined;                /**< the joint has a "clinical" object */
+    int has_neutral;
+    float neutral[3];           /**< unit: the segment's direction in the neutral posture */
+    float flexion[3];           /**< unit, nominal positive flexion axis */
+    float abduction[3];         /**< unit, nominal positive abduction axis */
+    int rotation_sign;          /**< +1: right-handed about the distal direction, -1: proximal */
+    char names[3][PP_CLINICAL_NAME_MAX]; /**< "" = libpose's default name */
+    uint32_t limit_flags;       /**< POSE_LIMIT_X/Y/Z = flexion/abduction/rotation limited */
+    float limit_min_deg[3], limit_max_deg[3];
+} pp_template_clinical;
+
 typedef struct pp_template_joint {
     char name[PP_NAME_MAX];
     int parent;                 /**< index of an earlier joint, -1 for the root */
@@ -71,6 +103,7 @@ typedef struct pp_template_joint {
     uint32_t limit_flags;       /**< POSE_LIMIT_* */
     pose_euler_order limit_order;
     float limit_min_deg[3], limit_max_deg[3];
+    pp_template_clinical clinical;
 } pp_template_joint;
 
 typedef struct pp_template {

@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <cmocka.h>
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -78,6 +79,57 @@ static void test_rejects_malformed(void **state)
         {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
                    "\"bones\": [\"g\"]}]}",
          POSE_ERR_FORMAT, "t.json:3: joint 'hip': key 'bones' appears twice"},
+        /* "clinical": the neutral posture and clinical axes. */
+        {HEAD "{\"name\": \"pelvis\", \"parent\": null, \"rule\": \"root\", \"bones\": [\"p\"], "
+              "\"clinical\": {\"flexion\": [0, 1, 0], \"abduction\": [1, 0, 0], \"rotation\": 1}}]}",
+         POSE_ERR_INVALID_DATA, "t.json:2: joint 'pelvis': the root has no clinical angles"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"clinical\": [0, 1, 0]}]}",
+         POSE_ERR_FORMAT, "t.json:3: joint 'hip': 'clinical' must be an object"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"clinical\": {\"flexion\": [0, 1, 0], \"rotation\": 1}}]}",
+         POSE_ERR_FORMAT, "joint 'hip': 'clinical' needs 'flexion', 'abduction' and 'rotation'"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"clinical\": {\"flexion\": [0, 0, 0], \"abduction\": [1, 0, 0], \"rotation\": 1}}]}",
+         POSE_ERR_FORMAT, "joint 'hip': 'clinical.flexion' must be a non-zero [x, y, z]"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"clinical\": {\"neutral\": \"down\", \"flexion\": [0, 1, 0], \"abduction\": [1, 0, 0], "
+                   "\"rotation\": 1}}]}",
+         POSE_ERR_FORMAT, "joint 'hip': 'clinical.neutral' must be a non-zero [x, y, z]"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"clinical\": {\"flexion\": [0, 1, 0], \"abduction\": [1, 0, 0], \"rotation\": 0}}]}",
+         POSE_ERR_FORMAT, "t.json:3: joint 'hip': 'clinical.rotation' must be 1"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"clinical\": {\"flexion\": [0, 1, 0], \"abduction\": [0, 1, 0.2], \"rotation\": 1}}]}",
+         POSE_ERR_INVALID_DATA, "joint 'hip': 'clinical.flexion' and 'clinical.abduction' are 11 degrees apart"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"clinical\": {\"neutral\": [1, 0, 0], \"flexion\": [0, 1, 0], \"abduction\": [1, 0, 0], "
+                   "\"rotation\": 1}}]}",
+         POSE_ERR_INVALID_DATA, "'clinical.neutral' and 'clinical.abduction' are 0 degrees apart"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"clinical\": {\"flexion\": [0, 1, 0], \"abduction\": [1, 0, 0], \"rotation\": 1, "
+                   "\"names\": [\"flexion\", \"abduction\"]}}]}",
+         POSE_ERR_FORMAT, "joint 'hip': 'clinical.names' must be 3 names"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"clinical\": {\"flexion\": [0, 1, 0], \"abduction\": [1, 0, 0], \"rotation\": 1, "
+                   "\"names\": [\"flexion\", \"\", \"rotation\"]}}]}",
+         POSE_ERR_FORMAT, "joint 'hip': 'clinical.names' entry 1 must be a string of 1..31 bytes"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"clinical\": {\"flexion\": [0, 1, 0], \"abduction\": [1, 0, 0], \"rotation\": 1, "
+                   "\"limits\": {\"flexion\": [120, -30]}}}]}",
+         POSE_ERR_FORMAT, "joint 'hip': 'clinical.limits.flexion' must be [min, max] degrees"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"clinical\": {\"flexion\": [0, 1, 0], \"abduction\": [1, 0, 0], \"rotation\": 1, "
+                   "\"limits\": {\"y\": [0, 10]}}}]}",
+         POSE_ERR_FORMAT, "unknown key 'clinical.limits.y' (expected flexion, abduction, rotation)"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"clinical\": {\"flexion\": [0, 1, 0], \"abduction\": [1, 0, 0], \"rotation\": 1, "
+                   "\"axis\": [0, 1, 0]}}]}",
+         POSE_ERR_FORMAT, "t.json:3: joint 'hip': unknown key 'clinical.axis'"},
+        {HEAD ROOT ",\n{\"name\": \"hip\", \"parent\": \"pelvis\", \"rule\": \"ball\", \"bones\": [\"f\"], "
+                   "\"clinical\": {\"flexion\": [0, 1, 0], \"abduction\": [1, 0, 0], \"rotation\": 1, "
+                   "\"rotation\": -1}}]}",
+         POSE_ERR_FORMAT, "joint 'hip': key 'clinical.rotation' appears twice"},
         {HEAD "{\"name\": \"0123456789012345678901234567890123456789012345678901234567890123\", "
               "\"rule\": \"root\", \"bones\": [\"p\"]}]}",
          POSE_ERR_FORMAT, "'name' must be a string of 1..63 bytes"},
@@ -130,8 +182,34 @@ static void test_reads_minimal(void **state)
     assert_int_equal(pp_template_joint_of_bone(&t, "pat"), 1);
     assert_int_equal(pp_template_joint_of_bone(&t, "skin"), -1);
     assert_int_equal(t.joints[0].contact_mm, 4.0f); /* the default */
+    assert_false(j->clinical.defined);
     pp_template_free(&t);
     pp_template_free(&t); /* harmless twice */
+}
+
+static void test_reads_clinical(void **state)
+{
+    (void)state;
+    const char *text = HEAD ROOT ",\n{\"name\": \"shoulder_r\", \"parent\": \"pelvis\", \"rule\": \"ball\", "
+                            "\"bones\": [\"h\"], \"clinical\": {\"neutral\": [0, 0, -2], \"flexion\": [0, -1, 0], "
+                            "\"abduction\": [-1, 0, 0.1], \"rotation\": -1, \"comment\": \"glenohumeral\", "
+                            "\"names\": [\"flexion\", \"abduction\", \"internal_rotation\"], "
+                            "\"limits\": {\"flexion\": [-60, 180], \"rotation\": [-90, 70]}}}]}";
+    pp_template t;
+    char err[512];
+    assert_int_equal(pp_template_parse(text, strlen(text), "t.json", &t, err, sizeof err), POSE_OK);
+    const pp_template_clinical *k = &t.joints[1].clinical;
+    assert_true(k->defined && k->has_neutral);
+    assert_true(k->neutral[0] == 0.0f && k->neutral[2] == -1.0f); /* normalized */
+    assert_true(k->flexion[1] == -1.0f);
+    assert_true(fabsf(k->abduction[0] + 0.995037f) < 1e-6f && fabsf(k->abduction[2] - 0.0995037f) < 1e-6f);
+    assert_int_equal(k->rotation_sign, -1);
+    assert_string_equal(k->names[2], "internal_rotation");
+    assert_int_equal(k->limit_flags, POSE_LIMIT_X | POSE_LIMIT_Z);
+    assert_true(k->limit_min_deg[0] == -60.0f && k->limit_max_deg[0] == 180.0f);
+    assert_true(k->limit_min_deg[2] == -90.0f && k->limit_max_deg[2] == 70.0f);
+    assert_false(t.joints[0].clinical.defined);
+    pp_template_free(&t);
 }
 
 /* The shipped full-body template: the names other components map onto. */
@@ -161,6 +239,14 @@ static void test_full_body_template(void **state)
     for (size_t i = 0; i < t.joint_count; i++)
         bones += t.joints[i].bone_count;
     assert_int_equal(bones, 102);
+    /* Clinical data on every joint but the root, AAOS ranges where AAOS has
+     * them: shoulder flexion 180, extension 60; knee flexion 0..135. */
+    for (size_t i = 0; i < t.joint_count; i++)
+        assert_int_equal(t.joints[i].clinical.defined, t.joints[i].parent >= 0);
+    const pp_template_clinical *sh = &t.joints[pp_template_find_joint(&t, "shoulder_l")].clinical;
+    assert_true(sh->limit_min_deg[0] == -60.0f && sh->limit_max_deg[0] == 180.0f);
+    const pp_template_clinical *kn = &t.joints[pp_template_find_joint(&t, "knee_r")].clinical;
+    assert_true(kn->limit_min_deg[0] == 0.0f && kn->limit_max_deg[0] == 135.0f);
     pp_template_free(&t);
 }
 
@@ -170,6 +256,7 @@ int main(void)
         cmocka_unit_test(test_rejects_malformed),
         cmocka_unit_test(test_missing_file),
         cmocka_unit_test(test_reads_minimal),
+        cmocka_unit_test(test_reads_clinical),
         cmocka_unit_test(test_full_body_template),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
