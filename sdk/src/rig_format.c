@@ -15,8 +15,14 @@ const char *pose__section_name(uint32_t type)
     case POSE__SEC_TISSUES: return "tissues";
     case POSE__SEC_METADATA: return "metadata";
     case POSE__SEC_VOLUMES: return "volumes";
+    case POSE__SEC_CLINICAL: return "clinical";
     default: return "unknown";
     }
+}
+
+bool pose__section_known(uint32_t type)
+{
+    return (type >= POSE__SEC_SKELETON && type <= POSE__SEC_METADATA) || type == POSE__SEC_CLINICAL;
 }
 
 pose__skeleton_layout pose__skeleton_layout_of(uint64_t joints)
@@ -57,6 +63,12 @@ uint64_t pose__cor_size_of(uint64_t vertices)
 uint64_t pose__metadata_size_of(uint64_t length)
 {
     return POSE__RIG_SECTION_HEADER + pose__align64(length + 1u);
+}
+
+uint64_t pose__clinical_size_of(uint64_t joints)
+{
+    /* 192-byte records keep every record on a 64-byte boundary: no padding. */
+    return POSE__RIG_SECTION_HEADER + joints * POSE__RIG_CLINICAL_RECORD;
 }
 
 uint64_t pose__tissue_data_size(uint64_t vertices, uint64_t triangles)

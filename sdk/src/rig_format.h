@@ -16,6 +16,7 @@
 #define POSE__RIG_MAX_SECTIONS 64u
 #define POSE__RIG_SECTION_HEADER 64u    /* every section starts with 64 bytes of counts */
 #define POSE__RIG_TISSUE_RECORD 128u
+#define POSE__RIG_CLINICAL_RECORD 192u  /* one per joint, see pose__clinical_record */
 #define POSE__RIG_MAX_TISSUES 65535u
 #define POSE__RIG_MAX_COUNT 0xFFFFFFFFu /* vertex/tet/triangle counts: indices are uint32 */
 
@@ -46,7 +47,8 @@ enum {
 /** Entry flag: readers that do not know this type skip the section. */
 #define POSE__SECTION_OPTIONAL 1u
 
-/** Section types. 1..6 are version 1; 7 (volumes) is reserved; numbers are never reused. */
+/** Section types. 1..6 and 8 are version 1 (8, written since pose 0.2, is
+ *  optional); 7 (volumes) is reserved; numbers are never reused. */
 typedef enum pose__section_type {
     POSE__SEC_SKELETON = 1,
     POSE__SEC_TETMESH = 2,
@@ -55,11 +57,13 @@ typedef enum pose__section_type {
     POSE__SEC_TISSUES = 5,
     POSE__SEC_METADATA = 6,
     POSE__SEC_VOLUMES = 7, /* reserved for volumetric models */
-    POSE__SEC_LAST_KNOWN = 6
+    POSE__SEC_CLINICAL = 8 /* neutral posture, clinical axes and ranges per joint */
 } pose__section_type;
 
 /** Printable name of a section type ("skeleton", ...; "unknown" otherwise). */
 const char *pose__section_name(uint32_t type);
+/** Whether this library reads sections of `type` (others are skipped when optional). */
+bool pose__section_known(uint32_t type);
 
 /** Round up to the 64-byte alignment. */
 static inline uint64_t pose__align64(uint64_t n)
@@ -84,6 +88,7 @@ pose__tetmesh_layout pose__tetmesh_layout_of(uint64_t vertices, uint64_t tets);
 pose__weights_layout pose__weights_layout_of(uint64_t vertices, uint64_t influences);
 uint64_t pose__cor_size_of(uint64_t vertices);
 uint64_t pose__metadata_size_of(uint64_t length);
+uint64_t pose__clinical_size_of(uint64_t joints);
 /** Bytes one tissue's arrays take (positions, triangles, tet, bary, each padded). */
 uint64_t pose__tissue_data_size(uint64_t vertices, uint64_t triangles);
 

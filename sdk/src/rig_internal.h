@@ -28,6 +28,24 @@ typedef struct pose__joint_limit {
     float max_deg[3];
 } pose__joint_limit;
 
+/** Clinical angle names are stored in fixed 32-byte slots (1..31 bytes, NUL). */
+#define POSE__CLINICAL_NAME_SIZE 32
+
+/** A joint's neutral posture, clinical axes and range of motion, as stored in
+ *  the optional `clinical` section (192 bytes, little-endian; see
+ *  docs/rig-format.md). A record with flags 0 is all zero. */
+typedef struct pose__clinical_record {
+    uint32_t flags;          /* POSE_CLINICAL_* */
+    uint32_t limit_flags;    /* POSE_LIMIT_X/_Y/_Z: deg[0]/[1]/[2] limited */
+    float neutral[4];        /* local rotation of the neutral posture */
+    float axes[3][3];        /* flexion, abduction, rotation axes in the rest frame */
+    float limit_min_deg[3];
+    float limit_max_deg[3];
+    uint8_t reserved[12];    /* zero */
+    char names[3][POSE__CLINICAL_NAME_SIZE];
+} pose__clinical_record;
+_Static_assert(sizeof(pose__clinical_record) == 192, "clinical record is 192 bytes on disk");
+
 /** One tissue surface; arrays point into the rig's storage. */
 typedef struct pose__tissue {
     const char *name;         /* NUL-terminated, < POSE__NAME_SIZE bytes */
@@ -58,6 +76,7 @@ struct pose_rig {
     const pose_transform *joint_rest_model;/* joint frame at rest, model space */
     const pose_transform *joint_rest_local;/* relative to parent (= rest_model for roots) */
     const pose__joint_limit *joint_limits;
+    const pose__clinical_record *clinical; /* joint_count records, or NULL (no section) */
 
     /* ---- tet mesh */
     size_t tet_vertex_count;
@@ -93,6 +112,12 @@ struct pose_rig {
 static inline const char *pose__joint_name(const pose_rig *rig, size_t j)
 {
     return rig->joint_names + j * POSE__NAME_SIZE;
+}
+
+/** Joint j's clinical record when it has clinical data, else NULL. */
+static inline const pose__clinical_record *pose__joint_clinical(const pose_rig *rig, size_t j)
+{
+    return rig->clinical && (rig->clinical[j].flags & POSE_CLINICAL_DEFINED) ? &rig->clinical[j] : NULL;
 }
 
 /**

@@ -56,5 +56,7 @@ pose_status pose__rig_open(uint8_t *image, size_t size, pose__rig_storage storag
 
 /** Content checks shared by every way of making a rig (rig_validate.c). */
 pose_status pose__rig_validate(const pose_rig *rig, const pose__source *src);
+/** The `clinical` section's records (rig_clinical.c); a no-op without one. */
+pose_status pose__clinical_validate(const pose_rig *rig, const pose__source *src);
 
 #endif /* POSE_RIG_IO_H */

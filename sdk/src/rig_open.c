@@ -170,8 +170,7 @@ static pose_status read_table(const pose__source *src, uint32_t flags, entry *e,
                                          (unsigned long long)e[k].offset,
                                          (unsigned long long)(e[k].offset + e[k].size));
         }
-        bool known = e[i].type >= POSE__SEC_SKELETON && e[i].type <= POSE__SEC_LAST_KNOWN;
-        if (!known && !(e[i].flags & POSE__SECTION_OPTIONAL))
+        if (!pose__section_known(e[i].type) && !(e[i].flags & POSE__SECTION_OPTIONAL))
             return pose__source_fail(src, POSE_ERR_FORMAT, name, e[i].at,
                                      "section type %u is unknown to format version %u and not "
                                      "marked optional", e[i].type, POSE__RIG_VERSION);
@@ -340,6 +339,26 @@ static pose_status map_metadata(const pose__source *src, const entry *s, pose_ri
     return POSE_OK;
 }
 
+/* One record per joint; the records' content is checked by rig_clinical.c. */
+static pose_status map_clinical(const pose__source *src, const entry *s, pose_rig *rig)
+{
+    const uint8_t *p = src->base + s->offset;
+    pose_status st = need_header(src, s);
+    if (st != POSE_OK)
+        return st;
+    uint32_t j = get_u32(p);
+    if (j != rig->joint_count)
+        return pose__source_fail(src, POSE_ERR_INVALID_DATA, "clinical", p,
+                                 "records for %u joints, the skeleton has %zu", j, rig->joint_count);
+    if (!all_zero(p + 4, POSE__RIG_SECTION_HEADER - 4))
+        return pose__source_fail(src, POSE_ERR_FORMAT, "clinical", p + 4,
+                                 "reserved header bytes are not zero");
+    if (pose__clinical_size_of(j) != s->size)
+        return size_mismatch(src, s, pose__clinical_size_of(j), "its joint count");
+    rig->clinical = (const pose__clinical_record *)(const void *)(p + POSE__RIG_SECTION_HEADER);
+    return POSE_OK;
+}
+
 /* Tissue records hold counts and offsets; the offsets must follow the one
  * canonical layout, which rules out overlaps and misalignment at once. */
 static pose_status map_tissues(const pose__source *src, const entry *s, pose_rig *rig,
@@ -423,6 +442,8 @@ static pose_status map_sections(const pose__source *src, const entry *e, uint32_
         st = map_cor(src, find(e, n, POSE__SEC_COR), rig);
     if (st == POSE_OK && find(e, n, POSE__SEC_METADATA))
         st = map_metadata(src, find(e, n, POSE__SEC_METADATA), rig);
+    if (st == POSE_OK && find(e, n, POSE__SEC_CLINICAL))
+        st = map_clinical(src, find(e, n, POSE__SEC_CLINICAL), rig);
     if (st != POSE_OK)
         return st;
 

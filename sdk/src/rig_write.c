@@ -32,6 +32,30 @@ static pose_status check_name(const char *name, const char *what, size_t index)
     return POSE_OK;
 }
 
+/* Names that replace NULL in a description's clinical entries. */
+static const char *const k_default_clinical_names[3] = {"flexion", "abduction",
+                                                        "internal_rotation"};
+
+/* Clinical names must fit their 32-byte slots; the rest is the loader's job. */
+static pose_status check_clinical(const pose_rig_desc *d)
+{
+    for (size_t j = 0; d->clinical && j < d->joint_count; j++) {
+        if (!d->clinical[j].flags)
+            continue;
+        for (int k = 0; k < 3; k++) {
+            const char *name = d->clinical[j].names[k];
+            if (name && (name[0] == '\0' || strnlen(name, POSE__CLINICAL_NAME_SIZE) >=
+                                                 POSE__CLINICAL_NAME_SIZE))
+                return pose__fail(POSE_ERR_INVALID_ARGUMENT,
+                                  "rig description: section 'clinical': joint %zu ('%s'): name of "
+                                  "angle %d must be 1..%d bytes (or NULL for '%s')", j,
+                                  d->joints[j].name, k, POSE__CLINICAL_NAME_SIZE - 1,
+                                  k_default_clinical_names[k]);
+        }
+    }
+    return POSE_OK;
+}
+
 /* Everything the image needs before bytes are written: counts within the
  * format's limits and arrays present. Sizes stay far below 2^64. */
 static pose_status check_desc(const pose_rig_desc *d)
@@ -79,7 +103,7 @@ static pose_status check_desc(const pose_rig_desc *d)
                               "rig description: tissue '%s': missing positions, tet, bary or "
                               "triangles array", td->name);
     }
-    return POSE_OK;
+    return check_clinical(d);
 }
 
 typedef struct section_plan {
@@ -141,6 +165,31 @@ static void write_cor(uint8_t *s, const pose_rig_desc *d)
     put_array(s + POSE__RIG_SECTION_HEADER, d->cor, (uint64_t)d->tet_vertex_count * 12u);
 }
 
+/* Joints without clinical data get an all-zero record, whatever else their
+ * description entry holds. */
+static void write_clinical(uint8_t *s, const pose_rig_desc *d)
+{
+    put_u32(s, (uint32_t)d->joint_count);
+    for (size_t j = 0; j < d->joint_count; j++) {
+        const pose_joint_clinical *c = &d->clinical[j];
+        if (!c->flags)
+            continue;
+        pose__clinical_record r;
+        memset(&r, 0, sizeof r);
+        r.flags = c->flags;
+        r.limit_flags = c->limit_flags;
+        memcpy(r.neutral, c->neutral, sizeof r.neutral);
+        memcpy(r.axes, c->axes, sizeof r.axes);
+        memcpy(r.limit_min_deg, c->limit_min_deg, sizeof r.limit_min_deg);
+        memcpy(r.limit_max_deg, c->limit_max_deg, sizeof r.limit_max_deg);
+        for (int k = 0; k < 3; k++) {
+            const char *name = c->names[k] ? c->names[k] : k_default_clinical_names[k];
+            memcpy(r.names[k], name, strlen(name));
+        }
+        memcpy(s + POSE__RIG_SECTION_HEADER + j * POSE__RIG_CLINICAL_RECORD, &r, sizeof r);
+    }
+}
+
 static void write_tissues(uint8_t *s, const pose_rig_desc *d)
 {
     put_u32(s, (uint32_t)d->tissue_count);
@@ -177,7 +226,7 @@ pose_status pose__rig_serialize(const pose_rig_desc *d, const pose_allocator *al
         return st;
     size_t meta_len = d->metadata ? strlen(d->metadata) : 0;
 
-    section_plan plan[6];
+    section_plan plan[7];
     uint32_t n = 0;
     plan[n++] = (section_plan){POSE__SEC_SKELETON, 0, pose__skeleton_layout_of(d->joint_count).size};
     plan[n++] = (section_plan){POSE__SEC_TETMESH, 0,
@@ -189,6 +238,8 @@ pose_status pose__rig_serialize(const pose_rig_desc *d, const pose_allocator *al
     plan[n++] = (section_plan){POSE__SEC_TISSUES, 0, tissues_size(d)};
     if (meta_len)
         plan[n++] = (section_plan){POSE__SEC_METADATA, 0, pose__metadata_size_of(meta_len)};
+    if (d->clinical)
+        plan[n++] = (section_plan){POSE__SEC_CLINICAL, 0, pose__clinical_size_of(d->joint_count)};
 
     uint64_t total = POSE__RIG_HEADER_SIZE + pose__align64((uint64_t)n * POSE__RIG_ENTRY_SIZE);
     for (uint32_t i = 0; i < n; i++) {
@@ -211,6 +262,7 @@ pose_status pose__rig_serialize(const pose_rig_desc *d, const pose_allocator *al
         case POSE__SEC_WEIGHTS: write_weights(s, d); break;
         case POSE__SEC_COR: write_cor(s, d); break;
         case POSE__SEC_TISSUES: write_tissues(s, d); break;
+        case POSE__SEC_CLINICAL: write_clinical(s, d); break;
         case POSE__SEC_METADATA:
             put_u64(s, meta_len);
             memcpy(s + POSE__RIG_SECTION_HEADER, d->metadata, meta_len);
@@ -218,6 +270,9 @@ pose_status pose__rig_serialize(const pose_rig_desc *d, const pose_allocator *al
         }
         uint8_t *e = img + POSE__RIG_HEADER_SIZE + i * POSE__RIG_ENTRY_SIZE;
         put_u32(e + POSE__ENT_TYPE, plan[i].type);
+        /* Readers before pose 0.2 skip what they do not know only when it is optional. */
+        if (plan[i].type == POSE__SEC_CLINICAL)
+            put_u32(e + POSE__ENT_FLAGS, POSE__SECTION_OPTIONAL);
         put_u64(e + POSE__ENT_OFFSET, plan[i].offset);
         put_u64(e + POSE__ENT_SIZE, plan[i].size);
         put_u32(e + POSE__ENT_CRC, pose__crc32(0, s, (size_t)plan[i].size));

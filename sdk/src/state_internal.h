@@ -22,6 +22,8 @@ struct pose_state {
     pose_method method;
 
     float (*local)[4];          /**< joint_count local rotations relative to rest */
+    float (*clinical)[3];       /**< joint_count: last clinical angles of joints with
+                                     clinical data (the triple nearest the last request) */
     pose__xform root;           /**< model placement on top of the roots */
     pose__xform *skin;          /**< joint_count: rest -> posed, model space */
     pose__xform *world;         /**< joint_count: posed joint frames */
@@ -52,5 +54,10 @@ size_t pose__state_frame_bytes(const pose_state *st);
 
 /** Joint rotation setters' shared tail: clamp q to joint j's limits, store it. */
 pose_status pose__state_store_joint(pose_state *st, int joint, float q[4]);
+/** pose__state_store_joint for a joint with clinical data: clamp the unit
+ *  quaternion q in the clinical convention, store it and its angles. */
+pose_status pose__state_store_clinical(pose_state *st, int joint, const float q[4]);
+/** Clinical angles of the rest pose for every joint with clinical data. */
+void pose__state_rest_clinical(pose_state *st);
 
 #endif /* POSE_STATE_INTERNAL_H */

@@ -111,6 +111,8 @@ static void euler_nearest_limits(const pose__joint_limit *lim, float deg[3])
 
 pose_status pose__state_store_joint(pose_state *st, int joint, float q[4])
 {
+    if (pose__joint_clinical(st->rig, (size_t)joint))
+        return pose__state_store_clinical(st, joint, q);
     pose_status s = POSE_OK;
     const pose__joint_limit *lim = &st->rig->joint_limits[joint];
     if (lim->flags & (POSE_LIMIT_X | POSE_LIMIT_Y | POSE_LIMIT_Z)) {
@@ -154,7 +156,8 @@ pose_status pose_set_joint_euler(pose_state *st, int joint, const float deg[3],
                           "pose_set_joint_euler: joint %d: angle not finite", joint);
     float q[4];
     const pose__joint_limit *lim = &st->rig->joint_limits[joint];
-    if ((lim->flags & 7u) && (int)lim->order == (int)order) {
+    if ((lim->flags & 7u) && (int)lim->order == (int)order &&
+        !pose__joint_clinical(st->rig, (size_t)joint)) {
         /* Same order as the limits: clamp the angles as given (a decomposition
          * could pick the other, equivalent triple and clamp the wrong axis). */
         float a[3] = {wrap_deg(deg[0]), wrap_deg(deg[1]), wrap_deg(deg[2])};
@@ -206,6 +209,7 @@ pose_status pose_reset(pose_state *st)
         return pose__fail(POSE_ERR_INVALID_ARGUMENT, "pose_reset: state is NULL");
     for (size_t j = 0; j < st->rig->joint_count; j++)
         pose__quat_identity(st->local[j]);
+    pose__state_rest_clinical(st);
     pose__xform_identity(&st->root);
     return POSE_OK;
 }

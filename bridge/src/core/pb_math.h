@@ -68,27 +68,12 @@ static inline void pb_quat_axis_deg(int axis, double deg, double q[4])
     q[3] = cos(h);
 }
 
-/** Axis order of a pose_euler_order, outermost first: ZXY -> {2, 0, 1}. */
-static inline void pb_euler_axes(pose_euler_order order, int axes[3])
-{
-    static const int table[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-    int o = (int)order >= 0 && (int)order < 6 ? (int)order : 0;
-    axes[0] = table[o][0]; axes[1] = table[o][1]; axes[2] = table[o][2];
-}
-
-/** Quaternion of Euler angles deg = {x, y, z} composed in `order`. */
-static inline void pb_quat_from_euler(const double deg[3], pose_euler_order order, double q[4])
-{
-    int ax[3];
-    pb_euler_axes(order, ax);
-    double r[4];
-    pb_quat_identity(q);
-    for (int i = 0; i < 3; i++) {
-        pb_quat_axis_deg(ax[i], deg[ax[i]], r);
-        pb_quat_mul(q, r, q);
-    }
-}
-
+/** Quaternion of Euler angles deg = {x, y, z} composed in `order`: libpose's
+ *  pose_euler_to_quat (the one implementation; float precision, renormalized
+ *  here in double). */
+void pb_quat_from_euler(const double deg[3], pose_euler_order order, double q[4]);
+/** Euler angles {x, y, z} of q in `order`, middle angle in [-90, 90]:
+ *  libpose's pose_quat_to_euler (float precision). */
 void pb_quat_to_euler(const double q[4], pose_euler_order order, double deg[3]);
 
 static inline double pb_quat_dot(const double a[4], const double b[4])

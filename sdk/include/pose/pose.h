@@ -60,7 +60,7 @@ extern "C" {
 /* ---------------------------------------------------------------- version */
 
 #define POSE_VERSION_MAJOR 0
-#define POSE_VERSION_MINOR 1
+#define POSE_VERSION_MINOR 2
 #define POSE_VERSION_PATCH 0
 /** Encoded as MAJOR*10000 + MINOR*100 + PATCH. Same major = same ABI. */
 #define POSE_VERSION_NUMBER \
@@ -291,7 +291,8 @@ typedef struct pose_joint_clinical {
     float axes[3][3];      /**< flexion, abduction, rotation axes: unit, orthogonal, in the rest frame */
     const char *names[3];  /**< what positive means per angle ("flexion", "abduction",
                                 "internal_rotation", "pronation" ...); owned by the rig
-                                (in a pose_rig_desc: 1..31 bytes each, or NULL for the defaults) */
+                                (in a pose_rig_desc: 1..31 bytes each, or NULL for the defaults
+                                "flexion", "abduction", "internal_rotation") */
     uint32_t limit_flags;  /**< POSE_LIMIT_X / _Y / _Z: deg[0] / deg[1] / deg[2] limited */
     float limit_min_deg[3];/**< clinical range of motion */
     float limit_max_deg[3];
@@ -306,23 +307,33 @@ enum {
 
 /**
  * The neutral posture and clinical axes of `joint`. POSE_ERR_UNSUPPORTED when
- * the rig has none for it (rigs written before format 1.1, joints such as the
- * root that have no clinical angles). @since 0.2
+ * the rig has none for it (rigs without the optional `clinical` section, e.g.
+ * written before pose 0.2; joints such as the root that have no clinical
+ * angles). The axes are stored as given; conversions use them
+ * orthonormalized from the flexion axis on (Gram-Schmidt); a left-handed set
+ * is allowed (rotation stays about the third axis as stored). @since 0.2
  */
 POSE_API pose_status pose_rig_joint_clinical(const pose_rig *rig, int joint, pose_joint_clinical *out);
 /** Clinical angles {flexion, abduction, rotation} (degrees) -> local rotation; no limits applied. @since 0.2 */
 POSE_API pose_status pose_clinical_to_local(const pose_rig *rig, int joint, const float deg[3], float quat_xyzw[4]);
 /**
  * Local rotation -> clinical angles. Two angle triples give every rotation
- * (abduction a and 180 - a); the one nearest `hint_deg` is returned (NULL:
- * the one inside the joint's limits, else abduction in [-90, 90]). @since 0.2
+ * (abduction a and 180 - a); the one nearest `hint_deg` is returned, each
+ * angle within 180 degrees of the hint's (NULL: the one inside the joint's
+ * limits, limited angles taken by whole turns into their range, else
+ * abduction in [-90, 90]). At gimbal lock (abduction +-90) only flexion +-
+ * rotation is defined: rotation is the hint's, else 0 (or its limit nearest 0),
+ * and flexion takes the rest. @since 0.2
  */
 POSE_API pose_status pose_local_to_clinical(const pose_rig *rig, int joint, const float quat_xyzw[4],
                                             const float hint_deg[3], float deg[3]);
 
-/** Unit quaternion {x,y,z,w} from Euler angles {x,y,z} in degrees (the one implementation). @since 0.2 */
+/** Unit quaternion {x,y,z,w} from Euler angles {x,y,z} in degrees (the one
+ *  implementation, computed in double); identity for an unknown order. @since 0.2 */
 POSE_API void pose_euler_to_quat(const float deg[3], pose_euler_order order, float quat_xyzw[4]);
-/** Euler angles {x,y,z} (degrees) of a unit quaternion, middle angle in [-90, 90]. @since 0.2 */
+/** Euler angles {x,y,z} (degrees) of a unit quaternion, middle angle in [-90, 90];
+ *  within 1e-6 of gimbal lock the middle angle is exactly +-90 and the last is 0.
+ *  Zeros for an unknown order. @since 0.2 */
 POSE_API void pose_quat_to_euler(const float quat_xyzw[4], pose_euler_order order, float deg[3]);
 
 /* ------------------------------------------------------- building rigs */
@@ -422,14 +433,21 @@ POSE_API pose_status pose_set_joint_euler(pose_state *state, int joint, const fl
                                           pose_euler_order order);
 /**
  * Set a joint from clinical angles {flexion, abduction, rotation} in degrees
- * from the neutral posture (see pose_joint_clinical). POSE_CLAMPED when the
- * joint's clinical range of motion changed them; POSE_ERR_UNSUPPORTED when
- * the rig has no clinical data for the joint. @since 0.2
+ * from the neutral posture (see pose_joint_clinical). Limited angles are
+ * taken by whole turns nearest their range (350 is -10), then clamped:
+ * POSE_CLAMPED when the joint's clinical range of motion changed them
+ * (pose_last_error() names the joint, the angle and the amount);
+ * POSE_ERR_UNSUPPORTED when the rig has no clinical data for the joint.
+ * @since 0.2
  */
 POSE_API pose_status pose_set_joint_clinical(pose_state *state, int joint, const float deg[3]);
-/** The joint's current clinical angles (the triple nearest the last request). @since 0.2 */
+/** The joint's current clinical angles (the triple nearest the last request:
+ *  as set by pose_set_joint_clinical after clamping; for a rotation set
+ *  otherwise, the triple inside the range, else the one nearest it).
+ *  POSE_ERR_UNSUPPORTED for a joint without clinical data. @since 0.2 */
 POSE_API pose_status pose_get_joint_clinical(const pose_state *state, int joint, float deg[3]);
-/** Every joint with clinical data to its neutral posture (the others to rest), root to identity. @since 0.2 */
+/** Every joint with clinical data to its neutral posture (the others to rest), root to identity.
+ *  POSE_CLAMPED if a joint's range of motion excludes its neutral posture. @since 0.2 */
 POSE_API pose_status pose_set_neutral(pose_state *state);
 /** The joint's current local rotation (after clamping). @since 0.1 */
 POSE_API pose_status pose_get_joint(const pose_state *state, int joint, float quat_xyzw[4]);
