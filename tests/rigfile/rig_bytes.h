@@ -9,7 +9,11 @@
 #include <stdint.h>
 #include <string.h>
 
-enum { SEC_SKELETON = 1, SEC_TETMESH, SEC_WEIGHTS, SEC_COR, SEC_TISSUES, SEC_METADATA };
+enum { SEC_SKELETON = 1, SEC_TETMESH, SEC_WEIGHTS, SEC_COR, SEC_TISSUES, SEC_METADATA, SEC_VOLUMES,
+       SEC_CLINICAL };
+/* A clinical record: 192 bytes per joint after the section's 64-byte header. */
+enum { CLIN_FLAGS = 0, CLIN_LIMIT_FLAGS = 4, CLIN_NEUTRAL = 8, CLIN_AXES = 24, CLIN_MIN = 60,
+       CLIN_MAX = 72, CLIN_RESERVED = 84, CLIN_NAMES = 96, CLIN_RECORD = 192 };
 
 static inline uint32_t rb_u32(const uint8_t *p) { uint32_t v; memcpy(&v, p, 4); return v; }
 static inline uint64_t rb_u64(const uint8_t *p) { uint64_t v; memcpy(&v, p, 8); return v; }

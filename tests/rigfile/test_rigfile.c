@@ -867,6 +867,242 @@ static void test_description_errors(void **state)
     pose_rig_free(rig);
 }
 
+/* ------------------------------------------------------------- clinical */
+
+/* pose_rig_joint_clinical returns the description's entry, names defaulted. */
+static void assert_clinical_matches(const pose_rig *rig, const pose_joint_clinical *want)
+{
+    static const char *const defaults[3] = {"flexion", "abduction", "internal_rotation"};
+    for (int j = 0; j < 3; j++) {
+        pose_joint_clinical got;
+        memset(&got, 0xCD, sizeof got);
+        if (!want[j].flags) {
+            assert_int_equal(pose_rig_joint_clinical(rig, j, &got), POSE_ERR_UNSUPPORTED);
+            assert_non_null(strstr(pose_last_error(), "no clinical data"));
+            continue;
+        }
+        assert_int_equal(pose_rig_joint_clinical(rig, j, &got), POSE_OK);
+        assert_int_equal(got.flags, POSE_CLINICAL_DEFINED);
+        assert_memory_equal(got.neutral, want[j].neutral, sizeof got.neutral);
+        assert_memory_equal(got.axes, want[j].axes, sizeof got.axes);
+        assert_int_equal(got.limit_flags, want[j].limit_flags);
+        assert_memory_equal(got.limit_min_deg, want[j].limit_min_deg, 12);
+        assert_memory_equal(got.limit_max_deg, want[j].limit_max_deg, 12);
+        for (int k = 0; k < 3; k++)
+            assert_string_equal(got.names[k], want[j].names[k] ? want[j].names[k] : defaults[k]);
+    }
+}
+
+static void test_clinical_round_trip(void **state)
+{
+    (void)state;
+    tiny_rig t;
+    tiny_rig_init(&t, 1, 1);
+    tiny_rig_add_clinical(&t);
+    image im = write_image(&t.desc);
+    /* Section 8, flagged optional so that pose 0.1 readers skip it. */
+    int e = rb_find(im.data, SEC_CLINICAL);
+    assert_true(e >= 0);
+    assert_int_equal(rb_u32(rb_entry(im.data, (uint32_t)e) + 4), 1);
+    uint64_t cl = rb_offset(im.data, SEC_CLINICAL);
+    assert_int_equal(rb_u64(rb_entry(im.data, (uint32_t)e) + 16), 64 + 3 * CLIN_RECORD);
+    assert_int_equal(rb_u32(im.data + cl), 3);
+    for (int i = 0; i < CLIN_RECORD; i++) /* root: no data, all zero */
+        assert_int_equal(im.data[cl + 64 + i], 0);
+    assert_string_equal((const char *)im.data + cl + 64 + 2 * CLIN_RECORD + CLIN_NAMES + 32,
+                        "radial_deviation");
+
+    const char *path = tmp_path("clinical.rig");
+    assert_int_equal(pose_rig_write_file(&t.desc, path), POSE_OK);
+    pose_rig *rig;
+    assert_int_equal(pose_rig_load(path, &rig), POSE_OK);
+    assert_rig_matches(rig, &t.desc);
+    assert_clinical_matches(rig, t.clinical);
+    pose_rig_free(rig);
+    assert_int_equal(pose_rig_load_memory(im.data, im.size, NULL, &rig), POSE_OK);
+    assert_clinical_matches(rig, t.clinical);
+    pose_rig_free(rig);
+    assert_int_equal(pose_rig_create(&t.desc, NULL, &rig), POSE_OK);
+    assert_clinical_matches(rig, t.clinical);
+    pose_rig_free(rig);
+    free(im.data);
+
+    /* Without clinical data: no section, and every joint says so. */
+    tiny_rig_init(&t, 1, 1);
+    im = write_image(&t.desc);
+    assert_int_equal(rb_find(im.data, SEC_CLINICAL), -1);
+    assert_int_equal(pose_rig_load_memory(im.data, im.size, NULL, &rig), POSE_OK);
+    memset(t.clinical, 0, sizeof t.clinical);
+    assert_clinical_matches(rig, t.clinical);
+    pose_joint_clinical c;
+    assert_int_equal(pose_rig_joint_clinical(rig, 3, &c), POSE_ERR_INVALID_ARGUMENT);
+    assert_int_equal(pose_rig_joint_clinical(NULL, 0, &c), POSE_ERR_INVALID_ARGUMENT);
+    pose_rig_free(rig);
+    free(im.data);
+}
+
+/* Rigs written before the clinical section existed (the committed seeds are
+ * pose 0.1 files) load unchanged and have no clinical data. */
+static void test_clinical_old_rigs_load(void **state)
+{
+    (void)state;
+    static const char *const files[] = {"valid_tiny_full.rig", "valid_tiny_minimal.rig",
+                                        "valid_tiny_no_cor.rig"};
+    for (size_t i = 0; i < sizeof files / sizeof files[0]; i++) {
+        char path[1024];
+        snprintf(path, sizeof path, "%s/%s", POSE_RIG_CORPUS, files[i]);
+        pose_rig *rig;
+        if (pose_rig_load(path, &rig) != POSE_OK)
+            fail_msg("%s: %s", path, pose_last_error());
+        assert_int_equal(pose_rig_joint_count(rig), 3);
+        pose_joint_clinical c;
+        for (int j = 0; j < 3; j++)
+            assert_int_equal(pose_rig_joint_clinical(rig, j, &c), POSE_ERR_UNSUPPORTED);
+        pose_rig_free(rig);
+    }
+}
+
+/* A clinical image and the file offset of joint j's record. */
+static image clinical_image(void)
+{
+    tiny_rig t;
+    tiny_rig_init(&t, 1, 1);
+    tiny_rig_add_clinical(&t);
+    return write_image(&t.desc);
+}
+
+static uint64_t record_of(image *im, int j)
+{
+    return rb_offset(im->data, SEC_CLINICAL) + 64 + (uint64_t)j * CLIN_RECORD;
+}
+
+static void put_f32(image *im, uint64_t off, float v)
+{
+    memcpy(im->data + off, &v, 4);
+    rb_fix_crcs(im->data, im->size);
+}
+
+static void test_clinical_damage(void **state)
+{
+    (void)state;
+    image im = clinical_image();
+    uint64_t r = record_of(&im, 1);
+    put_f32(&im, r + CLIN_NEUTRAL + 12, 1.1f); /* w: |q| = 1.13 */
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 4, "section 'clinical'",
+                      "joint 1 ('elbow'): neutral rotation has length 1.13", "unit quaternion",
+                      at(r + CLIN_NEUTRAL));
+    free(im.data);
+
+    im = clinical_image();
+    r = record_of(&im, 2);
+    put_f32(&im, r + CLIN_AXES + 12, 0.1f); /* abduction axis leans towards flexion */
+    put_f32(&im, r + CLIN_AXES + 16, 0.99498744f);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 4, "section 'clinical'",
+                      "joint 2 ('wrist'): flexion and abduction axes are not orthogonal",
+                      "dot product 0.1", at(r + CLIN_AXES + 12));
+    put_f32(&im, r + CLIN_AXES + 12, 0.0f);
+    put_f32(&im, r + CLIN_AXES + 16, 0.9f); /* short abduction axis */
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 2, "abduction axis has length 0.9",
+                      at(r + CLIN_AXES + 12));
+    put_f32(&im, r + CLIN_AXES + 16, NAN);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 2, "not finite", at(r + CLIN_NEUTRAL));
+    free(im.data);
+
+    im = clinical_image();
+    r = record_of(&im, 2);
+    memset(im.data + r + CLIN_NAMES + 32, 'x', 32);
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 3, "section 'clinical'",
+                      "name of the abduction angle is not NUL-terminated within 32 bytes",
+                      at(r + CLIN_NAMES + 32));
+    memset(im.data + r + CLIN_NAMES + 32, 0, 32);
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 2,
+                      "joint 2 ('wrist'): empty name for the abduction angle", at(r + CLIN_NAMES + 32));
+    free(im.data);
+
+    im = clinical_image();
+    r = record_of(&im, 2);
+    put_f32(&im, r + CLIN_MIN + 8, 90.0f); /* pronation [90, 85] */
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 3, "range of rotation is [90, 85]",
+                      "section 'clinical'", at(r + CLIN_MIN + 8));
+    put_f32(&im, r + CLIN_MIN + 8, -80.0f);
+    rb_put_u32(im.data + r + CLIN_LIMIT_FLAGS, 8);
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 2, "limit flags 0x8 unknown",
+                      at(r + CLIN_LIMIT_FLAGS));
+    rb_put_u32(im.data + r + CLIN_LIMIT_FLAGS, 7);
+    rb_put_u32(im.data + r + CLIN_FLAGS, 3);
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 2, "flags 0x3 unknown", at(r));
+    rb_put_u32(im.data + r + CLIN_FLAGS, 1);
+    im.data[r + CLIN_RESERVED + 5] = 1;
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 2, "reserved bytes",
+                      at(r + CLIN_RESERVED));
+    free(im.data);
+
+    /* A joint without data must be all zero; counts and sizes must agree. */
+    im = clinical_image();
+    r = record_of(&im, 0);
+    put_f32(&im, r + CLIN_MAX, 99.0f);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 3, "joint 0 ('root')",
+                      "without clinical data (flags 0) has non-zero bytes", at(r));
+    free(im.data);
+    im = clinical_image();
+    uint64_t cl = rb_offset(im.data, SEC_CLINICAL);
+    rb_put_u32(im.data + cl, 4);
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 3, "section 'clinical'",
+                      "records for 4 joints, the skeleton has 3", at(cl));
+    rb_put_u32(im.data + cl, 3);
+    im.data[cl + 10] = 1;
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_FORMAT, 2, "reserved header bytes", at(cl + 4));
+    im.data[cl + 10] = 0;
+    uint8_t *entry = rb_entry(im.data, (uint32_t)rb_find(im.data, SEC_CLINICAL));
+    rb_put_u64(entry + 16, 64 + 2 * CLIN_RECORD);
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_FORMAT, 3, "section 'clinical'",
+                      "but its joint count need exactly 640", at(cl));
+    free(im.data);
+}
+
+/* Descriptions get the same checks, named without byte offsets. */
+static void test_clinical_description_errors(void **state)
+{
+    (void)state;
+    tiny_rig t;
+    tiny_rig_init(&t, 1, 1);
+    tiny_rig_add_clinical(&t);
+    t.clinical[1].neutral[3] = 0.5f;
+    pose_rig *rig = (pose_rig *)1;
+    assert_int_equal(pose_rig_create(&t.desc, NULL, &rig), POSE_ERR_INVALID_DATA);
+    assert_null(rig);
+    assert_string_equal(pose_last_error(),
+                        "rig description: section 'clinical': joint 1 ('elbow'): neutral rotation "
+                        "has length 0.563016, expected a unit quaternion (tolerance 1e-4)");
+    tiny_rig_init(&t, 1, 1);
+    tiny_rig_add_clinical(&t);
+    t.clinical[2].names[2] = "a-name-of-exactly-32-bytes-xxxxx";
+    void *data;
+    size_t size;
+    assert_int_equal(pose_rig_write_memory(&t.desc, NULL, &data, &size), POSE_ERR_INVALID_ARGUMENT);
+    assert_non_null(strstr(pose_last_error(), "joint 2 ('wrist'): name of angle 2 must be 1..31 bytes"));
+    t.clinical[2].names[2] = "";
+    assert_int_equal(pose_rig_create(&t.desc, NULL, &rig), POSE_ERR_INVALID_ARGUMENT);
+    t.clinical[2].names[2] = "a-name-of-exactly-31-bytes-xxxx";
+    t.clinical[2].limit_min_deg[0] = 100.0f;
+    assert_int_equal(pose_rig_create(&t.desc, NULL, &rig), POSE_ERR_INVALID_DATA);
+    assert_non_null(strstr(pose_last_error(), "range of flexion is [100, 80]"));
+    t.clinical[2].limit_min_deg[0] = -70.0f;
+    assert_int_equal(pose_rig_create(&t.desc, NULL, &rig), POSE_OK);
+    pose_joint_clinical c;
+    assert_int_equal(pose_rig_joint_clinical(rig, 2, &c), POSE_OK);
+    assert_string_equal(c.names[2], "a-name-of-exactly-31-bytes-xxxx");
+    pose_rig_free(rig);
+}
+
 static void test_status_strings_and_version(void **state)
 {
     (void)state;
@@ -904,6 +1140,10 @@ int main(void)
         cmocka_unit_test(test_round_trip_all_paths),
         cmocka_unit_test(test_rest_local_from_rest_model),
         cmocka_unit_test(test_allocation_failures),
+        cmocka_unit_test(test_clinical_round_trip),
+        cmocka_unit_test(test_clinical_old_rigs_load),
+        cmocka_unit_test(test_clinical_damage),
+        cmocka_unit_test(test_clinical_description_errors),
         cmocka_unit_test(test_status_strings_and_version),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

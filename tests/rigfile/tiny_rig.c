@@ -106,3 +106,34 @@ void tiny_rig_init(tiny_rig *t, int with_cor, int with_metadata)
         .metadata = with_metadata ? "tiny test rig\nwritten by tests/rigfile" : NULL,
     };
 }
+
+void tiny_rig_add_clinical(tiny_rig *t)
+{
+    memset(t->clinical, 0, sizeof t->clinical);
+    pose_joint_clinical *e = &t->clinical[1];
+    e->flags = POSE_CLINICAL_DEFINED;
+    e->neutral[0] = 0.25881905f; /* 30 degrees about x */
+    e->neutral[3] = 0.96592583f;
+    static const float elbow_axes[3][3] = {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}};
+    memcpy(e->axes, elbow_axes, sizeof elbow_axes);
+    e->limit_flags = POSE_LIMIT_X | POSE_LIMIT_Z;
+    e->limit_min_deg[0] = 0.0f;
+    e->limit_max_deg[0] = 150.0f;
+    e->limit_min_deg[2] = -80.0f;
+    e->limit_max_deg[2] = 80.0f;
+    pose_joint_clinical *w = &t->clinical[2];
+    w->flags = POSE_CLINICAL_DEFINED;
+    w->neutral[3] = 1.0f;
+    static const float wrist_axes[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, -1}};
+    memcpy(w->axes, wrist_axes, sizeof wrist_axes);
+    w->names[0] = "flexion";
+    w->names[1] = "radial_deviation";
+    w->names[2] = "pronation";
+    w->limit_flags = POSE_LIMIT_X | POSE_LIMIT_Y | POSE_LIMIT_Z;
+    static const float lo[3] = {-70, -20, -80}, hi[3] = {80, 30, 85};
+    memcpy(w->limit_min_deg, lo, sizeof lo);
+    memcpy(w->limit_max_deg, hi, sizeof hi);
+    /* Ignored: a joint without clinical data is written as zeros. */
+    t->clinical[0].limit_max_deg[0] = 99.0f;
+    t->desc.clinical = t->clinical;
+}

@@ -24,10 +24,15 @@ typedef struct tiny_rig {
     uint32_t bone_triangles[3];
     uint32_t bone_tet[3];
     float bone_bary[3 * 4];
+    pose_joint_clinical clinical[3];
     pose_rig_desc desc;
 } tiny_rig;
 
 /** Fill `t`; `with_cor` / `with_metadata` select the optional sections. */
 void tiny_rig_init(tiny_rig *t, int with_cor, int with_metadata);
+/** Add the optional clinical section: root without clinical data, elbow with
+ *  a 30-degree neutral, right-handed axes, default names and two limited
+ *  angles, wrist with left-handed axes, its own names and three limits. */
+void tiny_rig_add_clinical(tiny_rig *t);
 
 #endif /* POSE_TEST_TINY_RIG_H */
