@@ -1,43 +1,47 @@
 /* SPDX-License-Identifier: Apache-2.0
- * pose-bridge replay: play a mocap clip onto a rig in real time through the
- * bridge thread, as a host would: the main thread is the host's frame loop
- * (60 Hz), takes the newest pose without waiting and applies it. */
+ * pose-bridge replay: play a clip or a HID/CAN recording onto a rig in real
+ * time through the public API (pose/bridge.h), as a host would: the bridge
+ * thread plays the source, the main thread is the host's frame loop (60 Hz)
+ * and applies the newest pose without waiting. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
-#include "bridge_apply.h"
-#include "clock.h"
+#include "cli_rig.h"
+#include "pose/bridge.h"
 #include "pose_bridge_cli.h"
-#include "runner.h"
 
 static void help(FILE *f)
 {
     fprintf(f,
-            "usage: pose-bridge replay CLIP [--skeleton ASF] --rig RIG [--map MAP] [options]\n"
-            "  CLIP            .bvh, or .amc (ASF from --skeleton, or NN.asf beside NN_MM.amc)\n"
+            "usage: pose-bridge replay SOURCE --rig RIG [--map MAP] [--skeleton ASF] [options]\n"
+            "  SOURCE          a clip (.bvh, .amc: ASF from --skeleton, or NN.asf beside NN_MM.amc),\n"
+            "                  a hid-recorder file (.hid) or a candump -l log (.log); these need --map;\n"
+            "                  or any source string of pose/bridge.h (hid:VID:PID, can0 ...)\n"
             "  --rig RIG       a .rig file (poses a pose_state and runs pose_apply each host frame),\n"
             "                  a .bvh/.asf whose skeleton is the rig, or 'self' (the clip's own skeleton)\n"
-            "  --map MAP       mapping JSON (default: joints of the same name)\n"
+            "  --map MAP       mapping JSON (clips: default joints of the same name)\n"
             "  --speed X       playback speed (default 1)\n"
             "  --afap          as fast as possible (no real-time pacing)\n"
             "  --loop          wrap at the end\n"
-            "  --rate HZ       bridge publish rate (default: the clip's; between frames is slerped)\n"
+            "  --rate HZ       clips: bridge publish rate (default: the clip's; between frames is slerped)\n"
             "  --host-rate HZ  the host frame loop's rate (default 60)\n"
             "  --frames N      stop after N published poses\n"
-            "  --duration S    stop after S seconds of clip time\n"
-            "  --start S       start at clip time S\n"
-            "  --out FILE.bvh  record the applied joint angles (flushed every frame)\n"
+            "  --duration S    stop after S seconds of recorded time\n"
+            "  --start S       start at recorded time S\n"
+            "  --out FILE.bvh  record the published joint angles (flushed every pose)\n"
             "  --rt-priority N run the bridge thread SCHED_FIFO at priority N when allowed\n"
             "  --json          print a JSON summary on stdout\n"
             "  --quiet         no status line\n"
-            "Status line (stderr): frame, bridge fps, lag of the bridge thread's wake-ups.\n");
+            "Status line (stderr): time, frame (clips), poses per second, lag of the bridge thread's\n"
+            "wake-ups (clips), the source's state.\n");
 }
 
 typedef struct replay_args {
-    const char *clip, *skeleton, *rig, *map, *out;
+    const char *source, *skeleton, *rig, *map, *out;
     double speed, rate, host_rate, duration, start;
     long frames, rt_priority;
     int afap, loop, json, quiet;
@@ -97,27 +101,67 @@ static int parse(int argc, char **argv, replay_args *a)
             a->json = 1;
         else if (strcmp(s, "--quiet") == 0)
             a->quiet = 1;
-        else if (s[0] != '-' && !a->clip)
-            a->clip = s;
+        else if (s[0] != '-' && !a->source)
+            a->source = s;
         else
             return -1;
 #undef NUM
     }
-    if (!a->clip || !a->rig || !(a->speed > 0) || !(a->host_rate > 0))
+    if (!a->source || !a->rig || !(a->speed > 0) || !(a->host_rate > 0))
         return -1;
     return 0;
 }
 
-static int ends_with(const char *s, const char *suf)
+static double now_s(void)
 {
-    size_t n = strlen(s), m = strlen(suf);
-    return n >= m && strcmp(s + n - m, suf) == 0;
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
-static int cmp_i64(const void *x, const void *y)
+static void sleep_until(double t)
 {
-    int64_t a = *(const int64_t *)x, b = *(const int64_t *)y;
-    return (a > b) - (a < b);
+    double d = t - now_s();
+    if (d <= 0)
+        return;
+    struct timespec ts = {(time_t)d, (long)((d - floor(d)) * 1e9)};
+    nanosleep(&ts, NULL);
+}
+
+static void status_line(const pose_bridge_status *st, double fps, int tty)
+{
+    if (st->frame_count >= 0)
+        fprintf(stderr, "%sframe %6ld/%ld  t %8.3f s  fps %6.1f  lag max %.3f ms  %s%s", tty ? "\r" : "",
+                st->frame, st->frame_count, st->media_s, fps, st->lag_max_ms,
+                pose_bridge_state_name(st->state), tty ? "" : "\n");
+    else
+        fprintf(stderr, "%st %8.3f s  poses %8llu  fps %6.1f  drops %llu  %s%s", tty ? "\r" : "", st->media_s,
+                (unsigned long long)st->poses, fps, (unsigned long long)st->drops,
+                pose_bridge_state_name(st->state), tty ? "" : "\n");
+}
+
+static void print_json(const replay_args *a, const pose_rig *rig, const pose_bridge_status *st,
+                       unsigned long long host_frames, unsigned long long applied, unsigned long long held,
+                       long clamped)
+{
+    printf("{\"clip\": ");
+    pb_cli_json_string(stdout, a->source);
+    printf(", \"kind\": \"%s\", \"rig_joints\": %zu, \"ticks\": %llu, \"last_frame\": %ld, \"media_s\": %.6f, "
+           "\"host_frames\": %llu, \"poses_applied\": %llu, \"held_frames\": %llu, \"clamped\": %ld, "
+           "\"samples\": %llu, \"drops\": %llu, \"lag_p50_ms\": %.4f, \"lag_p99_ms\": %.4f, \"lag_max_ms\": %.4f, "
+           "\"realtime\": %s, \"state\": \"%s\"",
+           st->kind, pose_rig_joint_count(rig), (unsigned long long)st->poses, st->frame, st->media_s, host_frames,
+           applied, held, clamped, (unsigned long long)st->samples, (unsigned long long)st->drops, st->lag_p50_ms,
+           st->lag_p99_ms, st->lag_max_ms, st->realtime ? "true" : "false", pose_bridge_state_name(st->state));
+    if (st->fault[0]) {
+        printf(", \"fault\": ");
+        pb_cli_json_string(stdout, st->fault);
+    }
+    if (a->out) {
+        printf(", \"recording\": ");
+        pb_cli_json_string(stdout, a->out);
+    }
+    printf("}\n");
 }
 
 static int run(int argc, char **argv)
@@ -132,124 +176,92 @@ static int run(int argc, char **argv)
         help(stderr);
         return 2;
     }
-    pb_error err = {{0}};
-    pb_clip *clip = NULL, *rig_clip = NULL;
-    pb_rig_skel *skel = NULL;
-    pb_mapping *map = NULL;
+    char err[512];
     pose_rig *rig = NULL;
     pose_state *st = NULL;
-    pb_runner *run = NULL;
+    pose_bridge *br = NULL;
     int rc = 1;
-    pose_status s = pb_clip_load(a.clip, a.skeleton, &clip, &err);
-    if (!s) {
-        if (ends_with(a.rig, ".rig")) {
-            s = pose_rig_load(a.rig, &rig);
-            if (s)
-                pb_fail(&err, s, "%s", pose_last_error());
-            if (!s)
-                s = pb_rig_skel_from_rig(rig, &skel, &err);
-            if (!s && (s = pose_state_create(rig, &st)) != POSE_OK)
-                pb_fail(&err, s, "%s", pose_last_error());
-        } else if (strcmp(a.rig, "self") == 0) {
-            s = pb_rig_skel_from_clip(clip, 1.0, &skel, &err);
-        } else {
-            s = pb_clip_load(a.rig, NULL, &rig_clip, &err);
-            if (!s)
-                s = pb_rig_skel_from_clip(rig_clip, 1.0, &skel, &err);
-        }
+    if (pb_cli_rig_load(a.rig, a.source, a.skeleton, &rig, err, sizeof err) < 0) {
+        fprintf(stderr, "pose-bridge replay: %s\n", err);
+        return 1;
     }
-    if (!s)
-        s = a.map ? pb_mapping_load(a.map, &map, &err) : pb_mapping_identity(&map, &err);
-    pb_runner_options o = {.speed = a.speed, .afap = a.afap, .loop = a.loop, .rate_hz = a.rate,
-                           .max_ticks = a.frames, .max_media_s = a.duration, .start_s = a.start,
-                           .record_path = a.out, .rt_priority = (int)a.rt_priority};
-    if (!s)
-        s = pb_runner_start_clip(clip, skel, map, &o, &run, &err);
-    if (s) {
-        fprintf(stderr, "pose-bridge replay: %s\n", err.message);
+    if (pose_state_create(rig, &st) < 0) {
+        fprintf(stderr, "pose-bridge replay: %s\n", pose_last_error());
         goto done;
     }
+    pose_bridge_options o = {
+        .size = sizeof o,
+        .map_path = a.map,
+        .skeleton = a.skeleton,
+        .play = a.afap ? POSE_BRIDGE_AS_FAST_AS_POSSIBLE : POSE_BRIDGE_REALTIME,
+        .speed = a.speed,
+        .loop = a.loop,
+        .start_s = a.start,
+        .end_s = a.duration > 0 ? a.start + a.duration : 0.0,
+        .max_poses = a.frames,
+        .rate_hz = a.rate,
+        .rt_priority = (int)a.rt_priority,
+        .record_path = a.out,
+    };
+    if (pose_bridge_open(a.source, rig, &o, &br) < 0) {
+        fprintf(stderr, "pose-bridge replay: %s\n", pose_last_error());
+        goto done;
+    }
+    for (size_t i = 0; i < pose_bridge_warning_count(br); i++)
+        fprintf(stderr, "warning: %s\n", pose_bridge_warning(br, i));
     int tty = isatty(2) && !a.quiet;
-    int64_t period = (int64_t)(1e9 / a.host_rate), next = pb_now_ns(), last_status = 0;
-    uint64_t host_frames = 0, applied = 0;
+    double period = 1.0 / a.host_rate, next = now_s(), last_status = 0, fps_t = next;
+    unsigned long long host_frames = 0, applied = 0, held = 0, fps_poses = 0;
     long clamped = 0;
+    double fps = 0;
+    pose_bridge_status bs = {.size = sizeof bs};
     for (;;) {
-        int fresh;
-        const pb_pose *p = pb_runner_latest(run, &fresh);
-        if (fresh) {
-            applied++;
-            if (st) {
-                int c = 0;
-                if (pb_pose_apply_to_state(p, st, &c) != POSE_OK || pose_apply(st) < 0) {
-                    fprintf(stderr, "pose-bridge replay: pose_apply: %s\n", pose_last_error());
-                    break;
-                }
-                clamped += c;
-            }
+        int ended = pose_bridge_wait(br, 0);
+        pose_bridge_frame fr;
+        if (pose_bridge_apply(br, st, &fr) < 0 || (fr.fresh && pose_apply(st) < 0)) {
+            fprintf(stderr, "pose-bridge replay: %s\n", pose_last_error());
+            goto done;
         }
+        applied += fr.fresh != 0;
+        held += fr.held != 0;
+        clamped += fr.clamped;
         host_frames++;
-        pb_runner_stats stt;
-        pb_runner_stats_get(run, &stt);
-        int64_t now = pb_now_ns();
-        if (!a.quiet && (now - last_status > 250000000 || !stt.running)) {
-            fprintf(stderr, "%sframe %6ld/%zu  t %8.3f s  fps %6.1f  lag %6.3f ms (max %.3f)%s", tty ? "\r" : "",
-                    stt.frame, clip->frame_count, stt.media_s, stt.fps, stt.lag_ms, stt.lag_max_ms,
-                    tty ? "" : "\n");
+        double now = now_s();
+        if (!a.quiet && (now - last_status > 0.25 || ended)) {
+            pose_bridge_status_get(br, &bs);
+            fps = now > fps_t ? (double)(bs.poses - fps_poses) / (now - fps_t) : 0.0;
+            fps_t = now;
+            fps_poses = bs.poses;
+            status_line(&bs, fps, tty);
             last_status = now;
         }
-        if (!stt.running)
+        if (ended)
             break;
         next += period;
-        if (!a.afap)
-            pb_sleep_until_ns(next);
+        if (a.afap)
+            pose_bridge_wait(br, 1);
         else
-            pb_runner_wait(run, 1);
+            sleep_until(next);
     }
     if (tty)
         fputc('\n', stderr);
-    pb_runner_stats fin;
-    pb_runner_stats_get(run, &fin);
-    size_t nl = fin.ticks < 65536 ? (size_t)fin.ticks : 65536;
-    int64_t *lags = malloc((nl ? nl : 1) * sizeof *lags);
-    nl = lags ? pb_runner_lags(run, lags, nl) : 0;
-    double p50 = 0, p99 = 0;
-    if (nl) {
-        qsort(lags, nl, sizeof *lags, cmp_i64);
-        p50 = (double)lags[nl / 2] * 1e-6;
-        p99 = (double)lags[(nl * 99) / 100] * 1e-6;
-    }
-    free(lags);
-    s = pb_runner_stop(run, &err);
-    run = NULL;
-    if (s) {
-        fprintf(stderr, "pose-bridge replay: %s\n", err.message);
+    if (pose_bridge_status_get(br, &bs) < 0) {
+        fprintf(stderr, "pose-bridge replay: %s\n", pose_last_error());
         goto done;
     }
-    if (a.json) {
-        printf("{\"clip\": ");
-        pb_cli_json_string(stdout, a.clip);
-        printf(", \"rig_joints\": %d, \"ticks\": %llu, \"last_frame\": %ld, \"media_s\": %.6f, "
-               "\"host_frames\": %llu, \"poses_applied\": %llu, \"clamped\": %ld, \"lag_p50_ms\": %.4f, "
-               "\"lag_p99_ms\": %.4f, \"lag_max_ms\": %.4f, \"realtime\": %s, \"state\": \"%s\"",
-               skel->joint_count, (unsigned long long)fin.ticks, fin.frame, fin.media_s,
-               (unsigned long long)host_frames, (unsigned long long)applied, clamped, p50, p99, fin.lag_max_ms,
-               fin.realtime ? "true" : "false", pb_source_state_name(fin.state));
-        if (a.out) {
-            printf(", \"recording\": ");
-            pb_cli_json_string(stdout, a.out);
-        }
-        printf("}\n");
+    if (bs.state == POSE_BRIDGE_FAULT) { /* the bridge thread stopped (a recording it could not write) */
+        fprintf(stderr, "pose-bridge replay: %s\n", bs.fault);
+        goto done;
     }
+    if (a.json)
+        print_json(&a, rig, &bs, host_frames, applied, held, clamped);
     rc = 0;
 done:
-    pb_runner_stop(run, NULL);
+    pose_bridge_close(br);
     pose_state_free(st);
     pose_rig_free(rig);
-    pb_mapping_free(map);
-    pb_rig_skel_free(skel);
-    pb_clip_free(rig_clip);
-    pb_clip_free(clip);
     return rc;
 }
 
-const pb_command pb_cmd_replay = {"replay", "play a mocap clip onto a rig in real time (status, recording)", run};
+const pb_command pb_cmd_replay = {"replay", "play a clip or a HID/CAN recording onto a rig in real time (status, recording)",
+                                  run};

@@ -255,14 +255,15 @@ static void expect_manual_matches(const char *source, const pose_rig *rig, const
 {
     int n = (int)pose_rig_joint_count(rig);
     assert_true(n <= MAX_J);
-    pose_bridge_options o = {.size = sizeof o, .map_path = map, .play = POSE_BRIDGE_AS_FAST_AS_POSSIBLE};
+    /* The first 1.2 s at x2, from the start: pose_at replays from the start, through the same filters. */
+    pose_bridge_options o = {.size = sizeof o, .map_path = map, .speed = 2.0, .end_s = 1.2};
     pose_bridge *run = open_ok(source, rig, &o);
     pose_state *ps;
     assert_int_equal(pose_state_create(rig, &ps), POSE_OK);
     static snap snaps[MAX_SNAPS];
     int count = 0;
     for (int ended = 0; !ended && count < MAX_SNAPS;) {
-        ended = pose_bridge_wait(run, 2);
+        ended = pose_bridge_wait(run, 15);
         pose_bridge_frame fr;
         assert_true(pose_bridge_apply(run, ps, &fr) >= 0);
         if (fr.fresh) {

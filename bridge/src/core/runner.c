@@ -97,6 +97,8 @@ static int publish(pb_runner *r, pb_pose *back, int64_t lag_ns)
     }
     pthread_mutex_lock(&r->mu);
     note_tick(r, back, lag_ns);
+    if (bad)
+        snprintf(r->stats.fault, sizeof r->stats.fault, "%.255s", r->err.message);
     pthread_mutex_unlock(&r->mu);
     return bad;
 }

@@ -51,7 +51,8 @@ typedef struct pb_runner_stats {
     int realtime;          /**< the thread got the SCHED_FIFO priority it asked for */
     pb_source_state source;/**< the source's own health (STALE while a CAN node is silent ...);
                                 clips: PB_SOURCE_OK */
-    char fault[256];       /**< message of the last STALE, DISCONNECTED or FAULT state; "" when none */
+    char fault[256];       /**< the last STALE, DISCONNECTED or FAULT message, or why the thread
+                                stopped (a recording it could not write); "" when none */
     uint64_t samples;      /**< source updates read (clips: poses) */
     uint64_t drops;        /**< options.count_drops */
     int64_t last_sample_ns;/**< CLOCK_MONOTONIC arrival of the newest sample; 0 before the first */
