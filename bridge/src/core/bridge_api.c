@@ -335,22 +335,27 @@ static int cmp_i64(const void *x, const void *y)
     return (a > b) - (a < b);
 }
 
-/* Lag percentiles from the runner's record of wake-ups (the first 65536). */
+/* Lag percentiles from the runner's record of wake-ups (the first 65536).
+ * Sorted again only when the record grew by an eighth (or is small), so a
+ * host may ask for the status every frame. */
 static void lag_percentiles(pose_bridge *b, uint64_t ticks, pose_bridge_status *o)
 {
     size_t n = ticks < 65536 ? (size_t)ticks : 65536;
-    if (!n)
-        return;
-    int64_t *lags = pb_bridge_alloc(b, n * sizeof *lags);
-    if (!lags)
-        return;
-    n = pb_runner_lags(b->runner, lags, n);
-    if (n) {
-        qsort(lags, n, sizeof *lags, cmp_i64);
-        o->lag_p50_ms = (double)lags[n / 2] * 1e-6;
-        o->lag_p99_ms = (double)lags[(n * 99) / 100] * 1e-6;
+    if (n != b->lag_ticks && (n < 4096 || n >= b->lag_ticks + b->lag_ticks / 8)) {
+        int64_t *lags = pb_bridge_alloc(b, n * sizeof *lags);
+        if (lags) {
+            size_t got = pb_runner_lags(b->runner, lags, n);
+            if (got) {
+                qsort(lags, got, sizeof *lags, cmp_i64);
+                b->lag_p50_ms = (double)lags[got / 2] * 1e-6;
+                b->lag_p99_ms = (double)lags[(got * 99) / 100] * 1e-6;
+            }
+            b->lag_ticks = got;
+            pb_bridge_free(b, lags);
+        }
     }
-    pb_bridge_free(b, lags);
+    o->lag_p50_ms = b->lag_p50_ms;
+    o->lag_p99_ms = b->lag_p99_ms;
 }
 
 pose_status pose_bridge_status_get(pose_bridge *b, pose_bridge_status *status)
