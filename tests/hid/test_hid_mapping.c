@@ -14,7 +14,7 @@
 
 #include <cmocka.h>
 
-#include "hid_calibrate.h"
+#include "calibrate.h"
 #include "hid_mannequin.h"
 #include "hid_open.h"
 #include "mapping.h"
@@ -281,6 +281,51 @@ static void test_calibration_round_trip(void **state)
     pb_mapping_free(m);
 }
 
+/* Neutral posture for every entry at once (hid-calibrate --neutral): the
+ * readings of a standing frame become 0 degrees, each entry keeping its gain. */
+static void test_neutral_calibration(void **state)
+{
+    (void)state;
+    char src_map[1024], map[1024];
+    repo_path(src_map, sizeof src_map, "bridge/maps/hid_mannequin_full_body.json");
+    snprintf(map, sizeof map, "%s/neutral.json", getenv("POSE_TEST_TMP") ? getenv("POSE_TEST_TMP") : "/tmp");
+    copy_file(src_map, map);
+    pb_error err;
+    pb_mapping *before = load_map("bridge/maps/hid_mannequin_full_body.json");
+    pb_source *src = replay("mannequin_sit_to_stand.hid");
+    assert_int_equal(pb_source_seek(src, 7600000000LL), 0); /* quiet standing */
+    double raw[16];
+    assert_int_equal(pb_calibrate_measure_entries(src, before, 100, 1000, raw, &err), POSE_OK);
+    /* the readings are the sensors' response to the generator's standing angles (noise averaged out) */
+    double deg[PB_MANNEQUIN_AXES];
+    pb_mannequin_pose(PB_MOTION_SIT_TO_STAND, 7.7, deg, NULL);
+    for (int i = 0; i < 16; i++) {
+        double g, o;
+        pb_mannequin_sensor(i, &g, &o);
+        assert_float_equal(raw[i], g * deg[i] + o, 0.3);
+    }
+    int written = 0;
+    assert_int_equal(pb_calibrate_write_neutral(map, before, raw, &written, &err), POSE_OK);
+    assert_int_equal(written, 16);
+    pb_mapping *after;
+    if (pb_mapping_load(map, &after, &err) != POSE_OK)
+        fail_msg("%s", err.message);
+    for (int i = 0; i < 16; i++) {
+        const pb_map_channel *a = &after->channels[i], *b = &before->channels[i];
+        assert_float_equal(pb_map_channel_transform(a, raw[i]), 0.0, 1e-9);
+        double slope_a = pb_map_channel_transform(a, raw[i] + 10) - pb_map_channel_transform(a, raw[i]);
+        double slope_b = pb_map_channel_transform(b, raw[i] + 10) - pb_map_channel_transform(b, raw[i]);
+        assert_float_equal(slope_a, slope_b, 1e-9);
+        assert_string_equal(a->joint, b->joint); /* the rest of the entry is untouched */
+        assert_string_equal(a->dof, b->dof);
+    }
+    /* a file the source cannot bind leaves nothing written: a missing map is an I/O error */
+    assert_int_equal(pb_calibrate_write_neutral("/nonexistent/m.json", before, raw, NULL, &err), POSE_ERR_IO);
+    pb_mapping_free(after);
+    pb_mapping_free(before);
+    pb_source_destroy(src);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -288,6 +333,7 @@ int main(void)
         cmocka_unit_test(test_full_body_follows),
         cmocka_unit_test(test_bar_follows),
         cmocka_unit_test(test_calibration_round_trip),
+        cmocka_unit_test(test_neutral_calibration),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

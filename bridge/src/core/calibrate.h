@@ -1,10 +1,13 @@
 /* SPDX-License-Identifier: Apache-2.0
- * Two-point calibration of scalar channels (the hid-calibrate command):
- * measure a channel while the joint is held at a known angle, then write
- * {"raw": [r0, r1], "deg": [d0, d1]} into the mapping file's entry. */
-#ifndef POSE_BRIDGE_HID_CALIBRATE_H
-#define POSE_BRIDGE_HID_CALIBRATE_H
+ * Calibration of scalar channels (the hid-calibrate and can-calibrate
+ * commands), for any source: measure channels while the joints are held at
+ * known angles -- the neutral posture for all of them at once, then one more
+ * known angle per channel -- and write {"raw": [r0, r1], "deg": [d0, d1]}
+ * into the mapping file's entries. */
+#ifndef POSE_BRIDGE_CALIBRATE_H
+#define POSE_BRIDGE_CALIBRATE_H
 
+#include "mapping.h"
 #include "pb_error.h"
 #include "source.h"
 
@@ -28,4 +31,21 @@ pose_status pb_calibrate_write(const char *map_path, const char *name, int index
 pose_status pb_calibrate_entry(const char *map_path, const char *name, int index, char *channel, size_t size,
                                uint32_t *usage, int *usage_index, pb_error *err);
 
-#endif /* POSE_BRIDGE_HID_CALIBRATE_H */
+/**
+ * The neutral posture of every entry at once: the mean of `samples` values of
+ * each channel the mapping's entries bind, read from src, into means[i] for
+ * entry i (NaN for an entry whose channel the source lacks).
+ */
+pose_status pb_calibrate_measure_entries(pb_source *src, const pb_mapping *map, int samples, int timeout_ms,
+                                         double *means, pb_error *err);
+
+/**
+ * Write neutral offsets: every entry whose neutral_raw[i] is finite gets the
+ * two-point calibration that reads neutral_raw[i] as 0 degrees and keeps its
+ * gain (degrees per raw unit; 1 without a calibration). `map` must be the
+ * parsed `map_path`. *written (may be NULL) counts the entries changed.
+ */
+pose_status pb_calibrate_write_neutral(const char *map_path, const pb_mapping *map, const double *neutral_raw,
+                                       int *written, pb_error *err);
+
+#endif /* POSE_BRIDGE_CALIBRATE_H */
