@@ -2,6 +2,19 @@
 # Install rules: headers, libraries, find_package(pose) config and pose.pc.
 include(CMakePackageConfigHelpers)
 
+# What the package config and pose_bridge.pc say about the bridge.
+if(TARGET pose_bridge)
+  set(POSE_CONFIG_BRIDGE TRUE)
+else()
+  set(POSE_CONFIG_BRIDGE FALSE)
+endif()
+if(POSE_BRIDGE_HAVE_HIDAPI)
+  set(POSE_CONFIG_HIDAPI TRUE)
+  string(APPEND POSE_BRIDGE_PC_LIBS_PRIVATE " -lhidapi-hidraw")
+else()
+  set(POSE_CONFIG_HIDAPI FALSE)
+endif()
+
 install(DIRECTORY "${PROJECT_SOURCE_DIR}/sdk/include/pose"
         DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}")
 install(EXPORT poseTargets NAMESPACE pose::
@@ -18,4 +31,8 @@ install(FILES "${PROJECT_BINARY_DIR}/poseConfig.cmake" "${PROJECT_BINARY_DIR}/po
 file(RELATIVE_PATH POSE_PC_UP "${CMAKE_INSTALL_FULL_LIBDIR}/pkgconfig" "${CMAKE_INSTALL_PREFIX}")
 configure_file("${PROJECT_SOURCE_DIR}/cmake/pose.pc.in" "${PROJECT_BINARY_DIR}/pose.pc" @ONLY)
 install(FILES "${PROJECT_BINARY_DIR}/pose.pc" DESTINATION "${CMAKE_INSTALL_LIBDIR}/pkgconfig")
+if(POSE_CONFIG_BRIDGE)
+  configure_file("${PROJECT_SOURCE_DIR}/cmake/pose_bridge.pc.in" "${PROJECT_BINARY_DIR}/pose_bridge.pc" @ONLY)
+  install(FILES "${PROJECT_BINARY_DIR}/pose_bridge.pc" DESTINATION "${CMAKE_INSTALL_LIBDIR}/pkgconfig")
+endif()
 install(FILES "${PROJECT_SOURCE_DIR}/LICENSE" DESTINATION "${CMAKE_INSTALL_DATADIR}/doc/pose" OPTIONAL)

@@ -3,10 +3,14 @@
 # The install rules, proven by a third party: install pose into a temporary
 # prefix, build examples/embed against it with find_package(pose) and with
 # the Makefile (pkg-config), build the README quickstart with pkg-config, and
-# run all three on the synthetic bar.
-#   embed_install.sh BUILD_DIR SOURCE_DIR POSE_SYNTH SCRATCH
+# run all three on the synthetic bar. When the bridge was installed, also
+# build examples/embed/bridge_host both ways and drive a state for 100 frames
+# from the HID mannequin recording (on BODY_RIG, a body baked from the
+# full-body template, else on the bar), and check that libpose_bridge.so
+# exports pose_bridge_* only.
+#   embed_install.sh BUILD_DIR SOURCE_DIR POSE_SYNTH SCRATCH [BODY_RIG]
 set -euo pipefail
-build=$1 src=$2 synth=$3 tmp=$4
+build=$1 src=$2 synth=$3 tmp=$4 body=${5:-}
 rm -rf "$tmp/prefix" "$tmp/embed-cmake" "$tmp/embed-make" "$tmp/out"
 mkdir -p "$tmp/embed-make" "$tmp/out/cmake" "$tmp/out/make"
 
@@ -48,4 +52,30 @@ cc -std=c11 -Wall -Wextra -Werror -o "$tmp/quickstart" "$src/examples/quickstart
     -Wl,-rpath,"$(pkg-config --define-prefix --variable=libdir pose)"
 "$tmp/quickstart" "$tmp/bar.rig" | tee "$tmp/run-quickstart.log"
 grep -q "moved up to" "$tmp/run-quickstart.log"
+
+# 4. The bridge, when installed: pose::bridge (CMake) and pose_bridge.pc (pkg-config).
+if [ -f "$tmp/prefix/include/pose/bridge.h" ]; then
+    test -x "$tmp/embed-cmake/bridge_host"
+    if [ -n "$body" ] && [ -f "$body" ]; then
+        rig=$body map="$src/bridge/maps/hid_mannequin_full_body.json"
+    else
+        rig="$tmp/bar.rig" map="$src/bridge/maps/hid_mannequin_bar.json"
+    fi
+    hid="$src/data/hid/mannequin_sit_to_stand.hid"
+    "$tmp/embed-cmake/bridge_host" "$rig" "$hid" "$map" 100 | tee "$tmp/run-bridge-cmake.log"
+    grep -q "in 100 frames" "$tmp/run-bridge-cmake.log"
+    ldd "$tmp/embed-cmake/bridge_host" | grep -q "$tmp/prefix/.*libpose_bridge.so"
+    make -s -C "$src/examples/embed" OUT="$tmp/embed-make" PKG_CONFIG="pkg-config --define-prefix" \
+        CFLAGS="-O2 -Wall -Wextra -Werror" bridge_host
+    "$tmp/embed-make/bridge_host" "$rig" "$hid" "$map" 100 | tee "$tmp/run-bridge-make.log"
+    grep -q "in 100 frames" "$tmp/run-bridge-make.log"
+    # The shared library exports the public API and nothing else.
+    lib=$(find "$tmp/prefix" -name 'libpose_bridge.so' | head -n 1)
+    nm -D --defined-only "$lib" | awk '{print $3}' >"$tmp/bridge-symbols.txt"
+    grep -q '^pose_bridge_open$' "$tmp/bridge-symbols.txt"
+    if grep -v '^pose_bridge_' "$tmp/bridge-symbols.txt"; then
+        echo "embed_install: libpose_bridge.so exports symbols outside pose/bridge.h (above)" >&2
+        exit 1
+    fi
+fi
 echo "embed_install: OK"
