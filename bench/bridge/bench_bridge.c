@@ -5,15 +5,22 @@
  * skeleton (onto itself and onto the 19-joint body template), target < 50 us;
  * scalar channel mapping per device sample; replay timing error p50/p99 at
  * x1 over S seconds (default 5), target p99 < 1 ms, with normal scheduling
- * and with the bridge thread at SCHED_FIFO priority 10 (when allowed). */
+ * and with the bridge thread at SCHED_FIFO priority 10 (when allowed); and
+ * sample -> posed state through the public API (pose/bridge.h): from the
+ * bridge thread publishing a device sample's pose to pose_bridge_apply
+ * having set the state, with the host polling without pause, for the 1 kHz
+ * HID recording and the CAN rig's log played at x1 (up to 4 s each). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include <sched.h>
 
 #include "clock.h"
 #include "mapping.h"
 #include "pb_math.h"
 #include "player.h"
+#include "pose/bridge.h"
 #include "runner.h"
 
 #ifndef POSE_BENCH_DATA
@@ -233,6 +240,69 @@ static int bench_replay(const pb_clip *clip, const pb_rig_skel *rig, const pb_ma
     return st.realtime;
 }
 
+/* The 19 joints of the body template with schematic clinical axes (the
+ * device maps speak clinical angles) and one token tet: the bridge reads
+ * only joints, and pose_bridge_apply only sets them. */
+static pose_rig *api_body_rig(const pose_joint_desc *d)
+{
+    pose_joint_clinical c[19];
+    memset(c, 0, sizeof c);
+    for (int j = 1; j < 19; j++) {
+        c[j].neutral[3] = 1.0f;
+        c[j].axes[0][1] = c[j].axes[1][0] = c[j].axes[2][2] = 1.0f;
+        c[j].flags = POSE_CLINICAL_DEFINED;
+    }
+    static const float tet_p[12] = {0, 0, 0, 0.01f, 0, 0, 0, 0.01f, 0, 0, 0, 0.01f};
+    static const uint32_t tet[4] = {0, 1, 2, 3};
+    static const uint16_t label[1] = {0}, wj[4] = {0, 0, 0, 0};
+    static const float w[4] = {1, 1, 1, 1};
+    pose_rig_desc desc = {.joint_count = 19, .joints = d, .tet_vertex_count = 4, .tet_positions = tet_p,
+                          .tet_count = 1, .tets = tet, .tet_labels = label, .influences = 1, .weight_joints = wj,
+                          .weights = w, .clinical = c};
+    pose_rig *rig = NULL;
+    if (pose_rig_create(&desc, NULL, &rig) != POSE_OK) {
+        fprintf(stderr, "bench_bridge: %s\n", pose_last_error());
+        exit(1);
+    }
+    return rig;
+}
+
+typedef struct api_latency {
+    double p50_us, p99_us, max_us;
+    long poses;
+} api_latency;
+
+/* Publication -> state set, as pose_bridge_frame.age_s measures it right
+ * after pose_bridge_apply has set the joints; the host polls, yielding. */
+static api_latency bench_api(const pose_rig *rig, const char *source, const char *map, double seconds)
+{
+    pose_bridge_options o = {.size = sizeof o, .map_path = map, .end_s = seconds};
+    pose_bridge *b;
+    pose_state *st;
+    if (pose_state_create(rig, &st) != POSE_OK || pose_bridge_open(source, rig, &o, &b) != POSE_OK) {
+        fprintf(stderr, "bench_bridge: %s\n", pose_last_error());
+        exit(1);
+    }
+    size_t cap = (size_t)(seconds * 5000) + 16, n = 0;
+    double *age = malloc(cap * sizeof *age);
+    while (!pose_bridge_wait(b, 0)) {
+        pose_bridge_frame f;
+        if (pose_bridge_apply(b, st, &f) < 0) {
+            fprintf(stderr, "bench_bridge: %s\n", pose_last_error());
+            exit(1);
+        }
+        if (f.fresh && n < cap)
+            age[n++] = f.age_s * 1e6;
+        sched_yield();
+    }
+    pose_bridge_close(b);
+    pose_state_free(st);
+    qsort(age, n, sizeof *age, cmp_d);
+    api_latency r = {n ? age[n / 2] : 0, n ? age[n * 99 / 100] : 0, n ? age[n - 1] : 0, (long)n};
+    free(age);
+    return r;
+}
+
 int main(int argc, char **argv)
 {
     int json = 0;
@@ -286,14 +356,24 @@ int main(int argc, char **argv)
     long ticks, rticks;
     bench_replay(clip, self, same, replay_s, 0, lag, &ticks);
     int rt = bench_replay(clip, self, same, replay_s, 10, rlag, &rticks);
+    pose_rig *api_rig = api_body_rig(d);
+    double api_s = replay_s < 4.0 ? replay_s : 4.0;
+    api_latency ah = bench_api(api_rig, POSE_BENCH_DATA "/hid/mannequin_reach_1khz.hid",
+                               POSE_BENCH_DATA "/../bridge/maps/hid_mannequin_full_body.json", api_s);
+    api_latency ac = bench_api(api_rig, POSE_BENCH_DATA "/can-rig/sit_stand_arm_raise.log",
+                               POSE_BENCH_DATA "/../bridge/maps/can_rig_fullbody.json", api_s);
+    pose_rig_free(api_rig);
     if (json) {
         printf("{\"bvh_parse_mb_s\": %.1f, \"frame_self_us\": {\"mean\": %.2f, \"p50\": %.2f, \"p99\": %.2f, "
                "\"clip_joints\": %d, \"rig_joints\": %d}, \"frame_body_us\": {\"mean\": %.2f, \"p50\": %.2f, "
                "\"p99\": %.2f, \"rig_joints\": %d}, \"channels16_us\": %.3f, \"replay_x1_lag_ms\": {\"p50\": %.4f, "
                "\"p99\": %.4f, \"max\": %.4f, \"ticks\": %ld}, \"replay_x1_fifo_lag_ms\": {\"p50\": %.4f, \"p99\": %.4f, "
-               "\"max\": %.4f, \"granted\": %s}}\n",
+               "\"max\": %.4f, \"granted\": %s}, \"api_sample_to_state_us\": {\"hid_1khz\": {\"p50\": %.1f, "
+               "\"p99\": %.1f, \"max\": %.1f, \"poses\": %ld}, \"can_rig\": {\"p50\": %.1f, \"p99\": %.1f, "
+               "\"max\": %.1f, \"poses\": %ld}}}\n",
                mbs, fs.mean_us, fs.p50_us, fs.p99_us, real_joints, fs.joints_out, fb.mean_us, fb.p50_us, fb.p99_us,
-               fb.joints_out, ch_us, lag[0], lag[1], lag[2], ticks, rlag[0], rlag[1], rlag[2], rt ? "true" : "false");
+               fb.joints_out, ch_us, lag[0], lag[1], lag[2], ticks, rlag[0], rlag[1], rlag[2], rt ? "true" : "false",
+               ah.p50_us, ah.p99_us, ah.max_us, ah.poses, ac.p50_us, ac.p99_us, ac.max_us, ac.poses);
     } else {
         printf("decode + retarget + publish, %d-joint CMU skeleton (+%d end sites) onto itself: mean %.2f us, "
                "p50 %.2f us, p99 %.2f us (target < 50 us)\n",
@@ -306,6 +386,10 @@ int main(int argc, char **argv)
                ticks, replay_s, lag[0], lag[1], lag[2]);
         printf("replay at x1, bridge thread SCHED_FIFO 10 (%s): lag p50 %.3f ms, p99 %.3f ms, max %.3f ms\n",
                rt ? "granted" : "NOT granted: normal scheduling", rlag[0], rlag[1], rlag[2]);
+        printf("sample -> posed state through pose/bridge.h (publication to pose_bridge_apply done, host polling):\n"
+               "  HID 1 kHz recording at x1, %ld poses: p50 %.1f us, p99 %.1f us, max %.1f us\n"
+               "  CAN rig log at x1, %ld poses: p50 %.1f us, p99 %.1f us, max %.1f us\n",
+               ah.poses, ah.p50_us, ah.p99_us, ah.max_us, ac.poses, ac.p50_us, ac.p99_us, ac.max_us);
     }
     pb_mapping_free(map);
     pb_mapping_free(same);
