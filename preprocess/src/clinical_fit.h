@@ -18,7 +18,9 @@ typedef struct pp_clinical_joint {
                                  into the template (NULL: libpose's default) */
     double neutral_deg;     /**< angle of the neutral offset */
     double model_axes[3][3];/**< the three axes in model space, in the neutral posture */
-    double distal[3];       /**< the segment's direction in the neutral posture (model) */
+    double distal[3];       /**< the segment's direction in the neutral posture (model; a
+                                 segment without a child joint: its parent's), which the
+                                 rotation axis follows */
     double neutral_motion[3][3]; /**< D: model-space rotation taking the segment from the
                                       rest pose to the neutral posture (row-major) */
 } pp_clinical_joint;
