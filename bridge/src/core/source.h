@@ -2,9 +2,11 @@
  *
  * The bridge's source interface: anything that yields timestamped channel
  * values (a HID device, a CAN bus, a mocap file, a recording of any of them).
- * One backend per file (hid_hidraw.c, can_socketcan.c, mocap_bvh.c,
- * replay_*.c), each filling a pb_source_ops table. Simulated devices are
- * sources that replay recordings through the same decoder as the live path.
+ * One backend per file, each filling a pb_source_ops table: hid/hid_source.c
+ * over the transports hid/hid_hidraw.c and hid/hid_replay.c,
+ * can/can_socketcan.c and can/candump_replay.c, mocap/mocap_source.c.
+ * Simulated devices are sources that replay recordings through the same
+ * decoder as the live path.
  *
  * Lifetime: a backend's open function allocates its whole struct (which
  * embeds pb_source first) with malloc/calloc and hands out the pb_source
