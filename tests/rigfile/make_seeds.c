@@ -30,15 +30,17 @@ int main(int argc, char **argv)
     }
     const char *dir = argv[1];
     int bad = 0;
-    static const struct { const char *name; int cor, meta; } valid[] = {
-        {"valid_tiny_full.rig", 1, 1}, {"valid_tiny_no_cor.rig", 0, 1},
-        {"valid_tiny_minimal.rig", 0, 0},
+    static const struct { const char *name; int cor, meta, clinical; } valid[] = {
+        {"valid_tiny_full.rig", 1, 1, 0}, {"valid_tiny_no_cor.rig", 0, 1, 0},
+        {"valid_tiny_minimal.rig", 0, 0, 0}, {"valid_tiny_clinical.rig", 1, 1, 1},
     };
     uint8_t *img;
     size_t size = 0;
     for (size_t i = 0; i < sizeof valid / sizeof valid[0]; i++) {
         tiny_rig t;
         tiny_rig_init(&t, valid[i].cor, valid[i].meta);
+        if (valid[i].clinical)
+            tiny_rig_add_clinical(&t);
         void *data;
         if (pose_rig_write_memory(&t.desc, NULL, &data, &size) != POSE_OK) {
             fprintf(stderr, "rigfile_make_seeds: %s\n", pose_last_error());
