@@ -572,6 +572,44 @@ static void test_allocator(void **state)
     pose_state_free(ps);
 }
 
+/* ------------------------------------------------------------- warnings */
+
+/* The HID recording with a 0x00 after its descriptor's last item: accepted,
+ * as the Linux kernel accepts it, with a warning naming the file and byte. */
+static void test_warnings(void **state)
+{
+    fixture *f = *state;
+    char path[512];
+    BT_TMP(path, "trailing_zero.hid");
+    FILE *in = fopen(f->hid, "r"), *out = fopen(path, "w");
+    assert_non_null(in);
+    assert_non_null(out);
+    char line[4096];
+    while (fgets(line, sizeof line, in)) {
+        unsigned n;
+        char *rest;
+        if (strncmp(line, "R: ", 3) == 0 && (n = (unsigned)strtoul(line + 3, &rest, 10)) > 0) {
+            rest[strcspn(rest, "\r\n")] = '\0';
+            fprintf(out, "R: %u%s 00\n", n + 1, rest);
+        } else {
+            fputs(line, out);
+        }
+    }
+    fclose(in);
+    fclose(out);
+    pose_bridge_play plays[2] = {POSE_BRIDGE_MANUAL, POSE_BRIDGE_AS_FAST_AS_POSSIBLE};
+    for (int k = 0; k < 2; k++) {
+        pose_bridge_options o = {.size = sizeof o, .map_path = f->map_hid, .play = plays[k]};
+        pose_bridge *b = open_ok(path, f->body, &o);
+        assert_int_equal(pose_bridge_warning_count(b), 1);
+        const char *w = pose_bridge_warning(b, 0);
+        if (!strstr(w, path) || !strstr(w, "trailing 0x00"))
+            fail_msg("warning \"%s\" does not name the file and the trailing byte", w);
+        assert_null(pose_bridge_warning(b, 1));
+        pose_bridge_close(b);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -586,6 +624,7 @@ int main(void)
         cmocka_unit_test(test_clip_pause_seek_speed),
         cmocka_unit_test(test_recording_pause_seek),
         cmocka_unit_test(test_allocator),
+        cmocka_unit_test(test_warnings),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
