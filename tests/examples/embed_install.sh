@@ -56,6 +56,11 @@ grep -q "moved up to" "$tmp/run-quickstart.log"
 # 4. The bridge, when installed: pose::bridge (CMake) and pose_bridge.pc (pkg-config).
 if [ -f "$tmp/prefix/include/pose/bridge.h" ]; then
     test -x "$tmp/embed-cmake/bridge_host"
+    # The installed headers are self-contained: each compiles alone, strictly.
+    for h in pose/pose.h pose/bridge.h; do
+        printf '#include <%s>\nint main(void) { return 0; }\n' "$h" >"$tmp/alone.c"
+        cc -std=c11 -Wall -Wextra -Werror -pedantic -I"$tmp/prefix/include" -c "$tmp/alone.c" -o "$tmp/alone.o"
+    done
     if [ -n "$body" ] && [ -f "$body" ]; then
         rig=$body map="$src/bridge/maps/hid_mannequin_full_body.json"
     else
