@@ -198,7 +198,6 @@ pose_status pose_bridge_open(const char *source, const pose_rig *rig, const pose
     b->map_path = bridge_strdup(b, o.map_path);
     b->map_json = bridge_strdup(b, o.map_json);
     b->skeleton = bridge_strdup(b, o.skeleton);
-    b->opt.record_path = NULL; /* only the runner reads it, during open */
     pose_status s;
     if (!b->source || (o.map_path && !b->map_path) || (o.map_json && !b->map_json) ||
         (o.skeleton && !b->skeleton)) {
@@ -207,13 +206,12 @@ pose_status pose_bridge_open(const char *source, const pose_rig *rig, const pose
         b->opt.map_path = b->map_path;
         b->opt.map_json = b->map_json;
         b->opt.skeleton = b->skeleton;
-        b->opt.record_path = o.record_path;
         /* Parsers report what they accepted with a warning to this thread's sink. */
         pb_warnings *prev = pb_warnings_install(&b->warnings);
         s = open_parts(b, &err);
         pb_warnings_install(prev);
-        b->opt.record_path = NULL;
     }
+    b->opt.record_path = NULL; /* the runner opened it; the caller's string need not outlive the call */
     if (s < 0) {
         pose_bridge_close(b);
         return fail(s, err.message[0] ? err.message : pose_status_string(s));
@@ -241,7 +239,7 @@ void pose_bridge_close(pose_bridge *b)
 
 /* ------------------------------------------------------------------ poses */
 
-static pose_status set_state(const pose_bridge *b, const pb_pose *p, pose_state *st, pose_bridge_frame *f)
+static pose_status set_state(const pb_pose *p, pose_state *st, pose_bridge_frame *f)
 {
     int clamped = 0;
     pose_status s = pb_pose_apply_to_state(p, st, &clamped);
@@ -253,7 +251,6 @@ static pose_status set_state(const pose_bridge *b, const pb_pose *p, pose_state 
     f->joints = n;
     f->clamped = clamped;
     f->media_s = p->media_s;
-    (void)b;
     return clamped ? POSE_CLAMPED : POSE_OK;
 }
 
@@ -285,7 +282,7 @@ pose_status pose_bridge_apply(pose_bridge *b, pose_state *st, pose_bridge_frame 
         const pb_pose *p = pb_runner_latest(b->runner, &fresh);
         f.held = pb_state_holds(pb_runner_source_state(b->runner));
         if (p->seq > 0) {
-            s = set_state(b, p, st, &f);
+            s = set_state(p, st, &f);
             if (s < 0)
                 return s;
             f.fresh = fresh;
@@ -317,7 +314,7 @@ pose_status pose_bridge_pose_at(pose_bridge *b, double t_s, pose_state *st, pose
     if (s < 0)
         return fail(s, err.message);
     pose_bridge_frame f = {.fresh = 1, .held = b->scrub.held, .seq = b->manual.seq + 1};
-    s = set_state(b, &b->scrub.pose, st, &f);
+    s = set_state(&b->scrub.pose, st, &f);
     if (s < 0)
         return s;
     f.age_s = t_s - b->scrub.media_s;
