@@ -26,7 +26,7 @@
  *
  *   path.bvh                    BVH clip
  *   path.amc                    ASF/AMC clip; the skeleton is options.skeleton, else
- *                               the .asf beside it (01_01.amc -> 01_01.asf, then 01.asf)
+ *                               the CMU subject's .asf beside it (01_01.amc -> 01.asf)
  *   path.hid                    hid-recorder file (simulated HID device)
  *   path.log                    candump -l log (simulated CAN bus)
  *   hid:VID:PID[:PAGE:USAGE]    live HID device (hex USB ids; optionally the top-level
@@ -41,11 +41,12 @@
  * folder, or from the working directory for map_json); clips map rig joints
  * to clip joints of the same name without one. Recorded times count from the
  * recording's start (a hid-recorder file's times, a candump log's first
- * frame); a live source's from its first sample. Mappings speak the clinical angle convention of pose.h
- * (pose_joint_clinical) where the rig knows its neutral posture: a device
- * reading 0 in the anatomical neutral posture puts the patient there.
+ * frame); a live source's from its first sample. Mappings speak the clinical
+ * angle convention of pose.h (pose_joint_clinical) where the rig knows its
+ * neutral posture: a device reading 0 in the anatomical neutral posture puts
+ * the patient there.
  *
- * Conventions are libpose's: opaque handles, every function returns a
+ * Conventions are libpose's: opaque handles, functions that can fail return a
  * pose_status and pose_last_error() (per thread) says what went wrong, naming
  * the file, line or offset; options structs are zero-default and carry their
  * own size. One bridge is used by one host thread at a time (its own thread
