@@ -206,7 +206,12 @@ POSE_BRIDGE_API pose_status pose_bridge_apply(pose_bridge *bridge, pose_state *s
 POSE_BRIDGE_API pose_status pose_bridge_pose_at(pose_bridge *bridge, double t_s, pose_state *state,
                                                 pose_bridge_frame *frame);
 
-/** Snapshot of the counters; status->size must be set. @since 0.2 */
+/**
+ * Snapshot of the counters; status->size must be set. Takes a short lock the
+ * bridge thread holds only between samples. The first call on a HID or CAN
+ * recording reads it through once, as fast as possible, to learn its length
+ * (milliseconds for the bundled recordings). @since 0.2
+ */
 POSE_BRIDGE_API pose_status pose_bridge_status_get(pose_bridge *bridge, pose_bridge_status *status);
 /**
  * Recorded sources played by the bridge thread: pause or resume. A paused
