@@ -1,21 +1,33 @@
 /* SPDX-License-Identifier: Apache-2.0
  * libFuzzer harness for the DBC parser: parse, then decode one frame of
  * every message from the input's own bytes (exercises the derived bit
- * positions and multiplexor chains the parser accepted). */
+ * positions and multiplexor chains the parser accepted). A warning sink is
+ * installed so the warning path (repeated pseudo-message signals ...) is
+ * formatted too. */
 #include <stddef.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "dbc_decode.h"
 #include "dbc_parse.h"
+#include "pb_warn.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
+    static pb_warnings warnings;
+    memset(&warnings, 0, sizeof warnings);
+    pb_warnings_install(&warnings);
     pb_dbc *d = NULL;
     pb_dbc_error err;
-    if (pb_dbc_parse((const char *)data, size, "fuzz.dbc", &d, &err) != 0)
+    int rc = pb_dbc_parse((const char *)data, size, "fuzz.dbc", &d, &err);
+    for (size_t i = 0; i < warnings.count; i++)
+        if (strlen(warnings.text[i]) >= PB_WARN_LEN)
+            abort();
+    pb_warnings_install(NULL);
+    if (rc != 0)
         return 0;
     uint8_t frame[64];
     memset(frame, 0xA5, sizeof frame);

@@ -1,18 +1,30 @@
 /* SPDX-License-Identifier: Apache-2.0
  * libFuzzer harness: report-descriptor parser, then the decoder over the
- * same bytes taken as a report of every declared input report ID. */
+ * same bytes taken as a report of every declared input report ID. A
+ * warning sink is installed so the warning path (reserved items, trailing
+ * zero bytes) is formatted too. */
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "hid_report.h"
+#include "pb_warn.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
+    static pb_warnings warnings;
+    memset(&warnings, 0, sizeof warnings);
+    pb_warnings_install(&warnings);
     pb_hid_desc *d;
     pb_error err;
-    if (pb_hid_desc_parse(data, size, "fuzz", &d, &err) != POSE_OK)
+    pose_status st = pb_hid_desc_parse(data, size, "fuzz", &d, &err);
+    for (size_t i = 0; i < warnings.count; i++)
+        if (strlen(warnings.text[i]) >= PB_WARN_LEN)
+            abort();
+    pb_warnings_install(NULL);
+    if (st != POSE_OK)
         return 0;
     size_t n = d->channel_count ? d->channel_count : 1;
     int32_t *lg = malloc(n * sizeof *lg);
