@@ -84,8 +84,6 @@ static void test_invalid(void **state)
     PARSE_ERR(late_id, "after fields without");
     static const uint8_t size_big[] = {0x76, 0x01, 0x01};
     PARSE_ERR(size_big, "report size");
-    static const uint8_t exp_big[] = {0x55, 0x7F};
-    PARSE_ERR(exp_big, "unit exponent");
     static const uint8_t delim[] = {0xA9, 0x00};
     PARSE_ERR(delim, "delimiter close");
     static const uint8_t delim_open[] = {0xA9, 0x01};
@@ -516,6 +514,29 @@ static void test_kernel_tolerated_items(void **state)
     assert_string_equal(d->channels[0].name, "GenericDesktop.Y");
     assert_string_equal(d->channels[1].name, "GenericDesktop.Y#1");
     assert_int_equal(d->fields[1].bit_offset, 8);
+    pb_hid_desc_free(d);
+
+    /* Accepted by the kernel, kept here with a warning: an exponent no double can
+     * carry (taken as 0) and a 32-bit unsigned maximum (clamped to INT32_MAX). */
+    static const uint8_t wide[] = {
+        0x05, 0x01, 0x15, 0x00, 0x27, 0xFF, 0xFF, 0xFF, 0xFF, /* 0..4294967295 */
+        0x55, 0x7F, 0x65, 0x11,                               /* 10^127 cm */
+        0x75, 0x20, 0x95, 0x01, 0x09, 0x30, 0x81, 0x02,
+    };
+    w.count = 0;
+    d = parse_ok(wide, sizeof wide);
+    assert_int_equal(w.count, 2);
+    assert_string_equal(w.text[0], "t.bin: report descriptor byte 9: unit exponent 127 out of -38..38 taken as 0 "
+                                   "(the Linux kernel accepts it)");
+    assert_non_null(strstr(w.text[1], "byte 19: logical maximum 4294967295 does not fit 32-bit signed values"));
+    const pb_hid_field *wf = &d->fields[0];
+    assert_int_equal(wf->logical_min, 0);
+    assert_int_equal(wf->logical_max, INT32_MAX);
+    assert_int_equal(wf->unit_exponent, 0);
+    const uint8_t r32[4] = {0x10, 0x00, 0x00, 0x00};
+    assert_int_equal(pb_hid_report_decode(d, r32, 4, lg, v, ok, &first, &count), PB_HID_DECODE_OK);
+    assert_int_equal(lg[0], 16);
+    assert_float_equal(v[0], 16.0, 1e-9);
     pb_hid_desc_free(d);
 
     /* More warnings than the sink keeps are counted; without a sink they are dropped. */

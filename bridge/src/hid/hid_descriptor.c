@@ -21,7 +21,10 @@
  *     and hid_open_report then refuses it ("unexpected long global item"),
  *     so do we (hid-tools refuses it too);
  *   - a Report Count above 12288 (the kernel's HID_MAX_USAGES) and a logical
- *     maximum below the logical minimum (hid_add_field) are refused.
+ *     maximum below the logical minimum (hid_add_field) are refused;
+ *   - what the kernel keeps but a 32-bit signed field cannot hold is kept with
+ *     a warning: an unsigned maximum above INT32_MAX (clamped) and a unit
+ *     exponent no double can carry (taken as 0).
  */
 #include "hid_descriptor.h"
 
@@ -274,8 +277,18 @@ static int main_data(parser *p, uint32_t tag, uint32_t data)
     bool is_signed = g->logical_min < 0;
     int64_t lmax = is_signed ? g->logical_max_s : g->logical_max_u;
     int64_t pmax = g->physical_min < 0 ? g->physical_max_s : g->physical_max_u;
-    if (lmax > INT32_MAX || g->logical_min < INT32_MIN || pmax > INT32_MAX || g->physical_min < INT32_MIN)
-        return fail(p, "logical or physical range beyond 32-bit signed values");
+    /* An unsigned maximum above INT32_MAX (e.g. Logical Maximum 0xFFFFFFFF for a 32-bit
+     * counter): the kernel keeps the field, its values being signed 32-bit as here;
+     * the maximum is clamped so that the range stays ordered. Minima are signed items. */
+    if (lmax > INT32_MAX) {
+        warn_at(p, "logical maximum %lld does not fit 32-bit signed values; kept as %d, as values above it "
+                   "decode negative (as in the Linux kernel)", (long long)lmax, INT32_MAX);
+        lmax = INT32_MAX;
+    }
+    if (pmax > INT32_MAX) {
+        warn_at(p, "physical maximum %lld does not fit 32-bit signed values; kept as %d", (long long)pmax, INT32_MAX);
+        pmax = INT32_MAX;
+    }
     int32_t parent = p->open_depth ? p->open[p->open_depth - 1] : -1;
 
     bool constant = data & PB_HID_CONSTANT, variable = data & PB_HID_VARIABLE;
@@ -391,8 +404,12 @@ static int global_item(parser *p, uint32_t tag, uint32_t u, int32_t s)
     case G_UNIT_EXPONENT:
         /* Spec: a 4-bit two's-complement nibble; devices also send a signed byte (kernel reading). */
         g->unit_exponent = u <= 0xF ? (int32_t)(u >= 8 ? (int32_t)u - 16 : (int32_t)u) : s;
-        if (g->unit_exponent < -38 || g->unit_exponent > 38)
-            return fail(p, "unit exponent %d out of range", g->unit_exponent);
+        if (g->unit_exponent < -38 || g->unit_exponent > 38) {
+            /* The kernel keeps any exponent (it only scales resolutions); 10^e beyond a
+             * double's reach would make every physical value 0 or infinite here. */
+            warn_at(p, "unit exponent %d out of -38..38 taken as 0 (the Linux kernel accepts it)", g->unit_exponent);
+            g->unit_exponent = 0;
+        }
         break;
     case G_UNIT:
         g->unit = u;
