@@ -33,6 +33,11 @@ static void test_bad_mapping_files(void **state)
     expect_parse_error("{\"channels\": [{\"channel\": \"a\", \"joint\": \"j\", \"axis\": \"w\"}]}",
                        "channels[0].axis: expected");
     expect_parse_error("{\"channels\": [{\"joint\": \"j\", \"axis\": \"x\"}]}", "channels[0]: needs \"channel\" or \"usage\"");
+    expect_parse_error("{\"channels\": [{\"channel\": \"a\", \"joint\": \"j\"}]}",
+                       "channels[0]: needs \"dof\" (a clinical angle) or \"axis\"");
+    expect_parse_error("{\"channels\": [{\"channel\": \"a\", \"joint\": \"j\", \"dof\": \"flexion\", \"axis\": \"x\"}]}",
+                       "channels[0]: \"axis\" and \"dof\" exclude each other");
+    expect_parse_error("{\"channels\": [{\"channel\": \"a\", \"joint\": \"j\", \"dof\": 3}]}", "channels[0].dof: expected");
     expect_parse_error("{\"channels\": [{\"channel\": \"a\", \"joint\": \"j\", \"axis\": \"x\", \"calibration\": "
                        "{\"raw\": [1, 1], \"deg\": [0, 90]}}]}",
                        "channels[0].calibration.raw: the two points are equal");
@@ -180,12 +185,101 @@ static void test_shipped_maps_parse(void **state)
     }
 }
 
+/* Clinical entries ("dof"): bound to the rig's clinical angles by generic or
+ * joint-specific name, composed as R(flexion axis) R(abduction axis) R(rotation
+ * axis) * neutral -- checked against libpose's own pose_clinical_to_local on a
+ * rig with clinical data; refused, with the entry named, where the rig has none. */
+static void test_clinical_channels(void **state)
+{
+    (void)state;
+    /* a one-joint rig: neutral a quarter turn about x; flexion about -y, abduction about +x, rotation about -z */
+    const float h = 0.70710678f;
+    pose_joint_desc jd = {.name = "shoulder", .parent = -1, .rest_model = {{0, 0, 0, 1}, {0, 0, 0}}};
+    pose_joint_clinical cl = {.neutral = {h, 0, 0, h},
+                              .axes = {{0, -1, 0}, {1, 0, 0}, {0, 0, -1}},
+                              .names = {"flexion", "abduction", "internal_rotation"},
+                              .limit_flags = 0,
+                              .flags = POSE_CLINICAL_DEFINED};
+    const float tet_p[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const uint32_t tet[4] = {0, 1, 2, 3};
+    const uint16_t lab[1] = {0}, wj[4] = {0, 0, 0, 0};
+    const float w[4] = {1, 1, 1, 1};
+    pose_rig_desc d = {.joint_count = 1, .joints = &jd, .tet_vertex_count = 4, .tet_positions = tet_p,
+                       .tet_count = 1, .tets = tet, .tet_labels = lab, .influences = 1, .weight_joints = wj,
+                       .weights = w, .clinical = &cl};
+    pose_rig *prig;
+    if (pose_rig_create(&d, NULL, &prig) != POSE_OK)
+        fail_msg("%s", pose_last_error());
+    pb_rig_skel *rig;
+    pb_error err;
+    assert_int_equal(pb_rig_skel_from_rig(prig, &rig, &err), POSE_OK);
+    const char *js = "{\"channels\": [{\"channel\": \"F\", \"joint\": \"shoulder\", \"dof\": \"flexion\"},"
+                     "{\"channel\": \"A\", \"joint\": \"shoulder\", \"dof\": \"abduction\"},"
+                     "{\"channel\": \"R\", \"joint\": \"shoulder\", \"dof\": \"internal_rotation\"}]}";
+    pb_mapping *m;
+    assert_int_equal(pb_mapping_parse(js, strlen(js), "m.json", &m, &err), POSE_OK);
+    pb_channel ch[3] = {{.name = "F"}, {.name = "A"}, {.name = "R"}};
+    pb_chanmap *cm;
+    if (pb_chanmap_create(m, ch, 3, rig, &cm, &err) != POSE_OK)
+        fail_msg("%s", err.message);
+    uint32_t idx[3] = {0, 1, 2};
+    double v[3] = {150, 20, -35};
+    pb_update u = {.t_ns = 0, .count = 3, .channels = idx, .values = v};
+    pb_chanmap_update(cm, &u);
+    pb_pose p;
+    assert_int_equal(pb_pose_init(&p, 1), 0);
+    pb_chanmap_pose(cm, &p);
+    const float deg[3] = {150, 20, -35};
+    float want[4];
+    assert_int_equal(pose_clinical_to_local(prig, 0, deg, want), POSE_OK);
+    double a[4] = {p.q[0][0], p.q[0][1], p.q[0][2], p.q[0][3]}, b[4] = {want[0], want[1], want[2], want[3]};
+    assert_true(bt_quat_angle_deg(a, b) < 1e-3);
+    /* and back: libpose reads the same clinical angles from the bridge's rotation */
+    float got[3];
+    assert_int_equal(pose_local_to_clinical(prig, 0, p.q[0], deg, got), POSE_OK);
+    for (int k = 0; k < 3; k++)
+        assert_near(got[k], deg[k], 1e-3);
+    pb_pose_free(&p);
+    pb_chanmap_free(cm);
+    pb_mapping_free(m);
+
+    /* an angle the joint does not have, and one joint mixing clinical and rest-frame entries */
+    const char *bad[2] = {"{\"channels\": [{\"channel\": \"F\", \"joint\": \"shoulder\", \"dof\": \"pronation\"}]}",
+                          "{\"channels\": [{\"channel\": \"F\", \"joint\": \"shoulder\", \"dof\": \"flexion\"},"
+                          "{\"channel\": \"A\", \"joint\": \"shoulder\", \"axis\": \"x\"}]}"};
+    const char *want_msg[2] = {"m.json: channels[0].dof: joint shoulder has no angle 'pronation' (it has flexion, "
+                               "abduction, internal_rotation)",
+                               "m.json: channels[1]: joint shoulder mixes \"dof\" and \"axis\" entries"};
+    for (int i = 0; i < 2; i++) {
+        assert_int_equal(pb_mapping_parse(bad[i], strlen(bad[i]), "m.json", &m, &err), POSE_OK);
+        assert_true(pb_chanmap_create(m, ch, 3, rig, &cm, &err) < 0);
+        assert_string_equal(err.message, want_msg[i]);
+        pb_mapping_free(m);
+    }
+    pb_rig_skel_free(rig);
+    pose_rig_free(prig);
+
+    /* a rig without clinical data: "dof" entries are refused, saying what to do */
+    pose_rig_desc plain = d;
+    plain.clinical = NULL;
+    assert_int_equal(pose_rig_create(&plain, NULL, &prig), POSE_OK);
+    assert_int_equal(pb_rig_skel_from_rig(prig, &rig, &err), POSE_OK);
+    assert_int_equal(pb_mapping_parse(js, strlen(js), "m.json", &m, &err), POSE_OK);
+    assert_int_equal(pb_chanmap_create(m, ch, 3, rig, &cm, &err), POSE_ERR_NOT_FOUND);
+    assert_non_null(strstr(err.message, "m.json: channels[0].dof: the rig has no neutral posture or clinical axes for "
+                                        "joint shoulder"));
+    pb_mapping_free(m);
+    pb_rig_skel_free(rig);
+    pose_rig_free(prig);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bad_mapping_files),
         cmocka_unit_test(test_unknown_joints),
         cmocka_unit_test(test_channel_stages),
+        cmocka_unit_test(test_clinical_channels),
         cmocka_unit_test(test_shipped_maps_parse),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

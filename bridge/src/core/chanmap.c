@@ -153,13 +153,13 @@ pose_status pb_chanmap_create(const pb_mapping *map, const pb_channel *channels,
         }
         /* One joint's entries are all clinical or all rest-frame Euler: the two do not compose. */
         for (int k = 0; k < i; k++)
-            if (c->e[k].joint == E->joint && (c->e[k].m.axis < 0) != (E->m.axis < 0)) {
+            if (c->e[k].joint == E->joint && !c->e[k].m.dof[0] != !E->m.dof[0]) {
                 pb_chanmap_free(c);
                 return pb_fail(err, POSE_ERR_INVALID_DATA,
                                "%s: channels[%d]: joint %s mixes \"dof\" and \"axis\" entries", map->path, i,
                                map->channels[i].joint);
             }
-        if (c->joint_entries[E->joint]++ && E->m.axis >= 0 && c->joint_order[E->joint] != E->m.order) {
+        if (c->joint_entries[E->joint]++ && !E->m.dof[0] && c->joint_order[E->joint] != E->m.order) {
             pb_chanmap_free(c);
             return pb_fail(err, POSE_ERR_INVALID_DATA, "%s: channels[%d].order: joint %s already uses another order",
                            map->path, i, map->channels[i].joint);

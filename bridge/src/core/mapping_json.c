@@ -266,11 +266,13 @@ static pose_status parse_channel(pb_mapping *m, const cJSON *e, int i, pb_error 
         snprintf(C->dof, sizeof C->dof, "%s", dof->valuestring);
         C->axis = -1;
     } else {
+        if (!ax)
+            return pb_fail(err, POSE_ERR_FORMAT,
+                           "%s: channels[%d]: needs \"dof\" (a clinical angle) or \"axis\" (a rest-frame Euler axis)",
+                           m->path, i);
         if (!cJSON_IsString(ax) || strlen(ax->valuestring) != 1 || (ax->valuestring[0] | 0x20) < 'x' ||
             (ax->valuestring[0] | 0x20) > 'z')
-            return pb_fail(err, POSE_ERR_FORMAT,
-                           "%s: channels[%d]: expected \"dof\" (clinical angle) or \"axis\": \"x\", \"y\" or \"z\"",
-                           m->path, i);
+            return pb_fail(err, POSE_ERR_FORMAT, "%s: channels[%d].axis: expected \"x\", \"y\" or \"z\"", m->path, i);
         C->axis = (ax->valuestring[0] | 0x20) - 'x';
     }
     C->order = POSE_EULER_XYZ;
