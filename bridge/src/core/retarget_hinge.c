@@ -115,3 +115,30 @@ int pb_clip_hinge_axes(const pb_clip *clip, const double *ref_values, const doub
     free(buf);
     return 0;
 }
+
+int pb_clip_mean_local(const pb_clip *clip, const int *want, double (*mean)[4])
+{
+    size_t n = (size_t)(clip->joint_count > 0 ? clip->joint_count : 1);
+    double *buf = calloc(n * 7, sizeof *buf);
+    if (!buf)
+        return -1;
+    double (*lq)[4] = (double (*)[4])buf, (*lt)[3] = (double (*)[3])(buf + 4 * n);
+    memset(mean, 0, n * sizeof *mean);
+    size_t step = clip->frame_count / HINGE_MAX_SAMPLES + 1;
+    for (size_t f = 0; f < clip->frame_count; f += step) {
+        pb_clip_local(clip, pb_clip_frame(clip, f), lq, lt);
+        for (int c = 0; c < clip->joint_count; c++) {
+            if (!want[c])
+                continue;
+            /* q and -q are one rotation: add each on the side of the sum so far */
+            double s = pb_quat_dot(mean[c], lq[c]) < 0 ? -1.0 : 1.0;
+            for (int k = 0; k < 4; k++)
+                mean[c][k] += s * lq[c][k];
+        }
+    }
+    for (int c = 0; c < clip->joint_count; c++)
+        if (want[c])
+            pb_quat_normalize(mean[c]);
+    free(buf);
+    return 0;
+}

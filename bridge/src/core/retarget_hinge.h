@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: Apache-2.0
- * Hinge axes of a clip's joints, measured from its motion.
+ * Hinge axes and mean postures of a clip's joints, measured from its motion.
  *
  * Rest alignment by bone directions alone leaves the twist of each segment
  * about its bone undetermined, and a knee or elbow whose flexion axis is
@@ -27,5 +27,14 @@
  */
 int pb_clip_hinge_axes(const pb_clip *clip, const double *ref_values, const double (*ref_wq)[4], double (*axis)[3],
                        int *ok);
+
+/**
+ * For every clip joint c with want[c] set, its mean local rotation (as
+ * pb_clip_local gives it) over the clip's frames: the normalized sum of the
+ * frames' quaternions, each taken on the sum's side (a good mean for
+ * rotations that stay within a few tens of degrees of each other). Other
+ * entries are left zero. Returns 0, or -1 when out of memory.
+ */
+int pb_clip_mean_local(const pb_clip *clip, const int *want, double (*mean)[4]);
 
 #endif /* POSE_BRIDGE_RETARGET_HINGE_H */
