@@ -20,9 +20,12 @@ endfunction()
 if(POSE_SANITIZE AND POSE_TSAN)
   message(FATAL_ERROR "POSE_SANITIZE and POSE_TSAN cannot be combined")
 endif()
+# Undefined behaviour aborts (-fno-sanitize-recover=all) in every sanitized
+# build: in recover mode UBSan only logs, so ctest passes and libFuzzer never
+# saves the input as a crash.
 if(POSE_SANITIZE)
   add_compile_options(-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer)
-  add_link_options(-fsanitize=address,undefined)
+  add_link_options(-fsanitize=address,undefined -fno-sanitize-recover=all)
 endif()
 if(POSE_TSAN)
   add_compile_options(-fsanitize=thread -fno-omit-frame-pointer)
@@ -33,8 +36,8 @@ if(POSE_FUZZ)
     message(FATAL_ERROR "POSE_FUZZ needs clang (CC=clang)")
   endif()
   # Instrument everything for coverage; the fuzzer main is linked only into fuzz targets.
-  add_compile_options(-fsanitize=fuzzer-no-link,address,undefined)
-  add_link_options(-fsanitize=address,undefined)
+  add_compile_options(-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all)
+  add_link_options(-fsanitize=address,undefined -fno-sanitize-recover=all)
 endif()
 
 find_package(Threads REQUIRED)

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0
  * pose-bridge can-record: everything a SocketCAN interface receives, error
  * frames included, written as a candump -l log (readable by candump's
- * tools, by can-decode and by the replay source). */
+ * tools, by can-decode and by the replay source), flushed per frame. */
 #define _GNU_SOURCE 1 /* sigaction */
 #include <errno.h>
 #include <signal.h>
@@ -10,9 +10,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "can_rx.h"
+#include "can_record.h"
 #include "can_source.h"
-#include "candump_log.h"
 #include "pose_bridge_cli.h"
 
 static volatile sig_atomic_t stop;
@@ -79,51 +78,17 @@ static int run(int argc, char **argv)
     sa.sa_handler = on_signal;
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
-    pb_can_rx rx;
-    pb_can_rx_init(&rx, fd);
-    const int progress = isatty(STDERR_FILENO);
-    const int64_t start = pb_can_mono_ns();
-    int64_t next_report = start + 1000000000;
-    unsigned long long frames = 0, drops = 0;
+    const pb_can_record_options ro = {
+        .seconds = seconds, .count = count, .stop = &stop, .progress = isatty(STDERR_FILENO)};
+    pb_can_record_result res;
     int status = 0;
-    while (!stop) {
-        const int64_t now = pb_can_mono_ns();
-        if (seconds > 0 && now - start >= (int64_t)(seconds * 1e9))
-            break;
-        if (progress && now >= next_report) {
-            fprintf(stderr, "\rpose-bridge can-record: %llu frames, %llu dropped, %.0f s", frames, drops,
-                    (now - start) * 1e-9);
-            next_report += 1000000000;
-        }
-        pb_can_frame fr;
-        int64_t real;
-        uint64_t d;
-        int r = pb_can_rx_read(&rx, &fr, &real, &d, 200);
-        drops += d;
-        if (r == 1) {
-            char line[PB_CANDUMP_LINE_MAX];
-            fr.t_ns = real;
-            int n = pb_candump_format(&fr, iface, line, sizeof line);
-            if (n > 0 && fwrite(line, 1, (size_t)n, f) != (size_t)n) {
-                fprintf(stderr, "pose-bridge can-record: write failed: %s\n", strerror(errno));
-                status = 1;
-                break;
-            }
-            if (count && ++frames >= count)
-                break;
-            if (!count)
-                frames++;
-        } else if (r == -1) {
-            if (errno == EINTR)
-                continue;
-            fprintf(stderr, "pose-bridge can-record: %s: %s\n", iface, strerror(errno));
-            status = 1;
-            break;
-        }
+    if (pb_can_record_run(fd, iface, f, &ro, &res, &err) != 0) {
+        fprintf(stderr, "pose-bridge can-record: %s\n", err.message);
+        status = 1;
     }
-    if (progress)
+    if (ro.progress)
         fputc('\n', stderr);
-    fprintf(stderr, "pose-bridge can-record: %llu frames, %llu dropped by the kernel\n", frames, drops);
+    fprintf(stderr, "pose-bridge can-record: %llu frames, %llu dropped by the kernel\n", res.frames, res.drops);
     if (out && fclose(f) != 0)
         status = 1;
     else if (!out)

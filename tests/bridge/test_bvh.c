@@ -219,6 +219,25 @@ static void check_hand_clip(const pb_clip *c)
     expect_pos(wp[5], 1, 5, 3);
 }
 
+/* A skeleton without channels (CHANNELS 0 everywhere) has frames but no
+ * values: the clip has no frame storage, and taking frame f must not do
+ * pointer arithmetic on NULL (undefined; UBSan aborts on it). */
+static void test_no_channels(void **state)
+{
+    (void)state;
+    pb_clip *c = NULL;
+    pb_error err = {{0}};
+    const char *text = "HIERARCHY\nROOT a\n{\nOFFSET 0 0 0\nCHANNELS 0\nEnd Site\n{\nOFFSET 0 1 0\n}\n}\n"
+                       "MOTION\nFrames: 2\nFrame Time: 0.1\n\n\n";
+    assert_int_equal(parse_text(text, &c, &err), POSE_OK);
+    assert_int_equal(c->channel_count, 0);
+    assert_int_equal(c->frame_count, 2);
+    double scratch[2 * 7], wq[2][4], wp[2][3];
+    pb_clip_fk(c, pb_clip_frame(c, 1), scratch, wq, wp);
+    expect_pos(wp[1], 0, 1, 0);
+    pb_clip_free(c);
+}
+
 static void test_hand_computed_fk(void **state)
 {
     (void)state;
@@ -320,6 +339,7 @@ int main(void)
         cmocka_unit_test(test_non_finite_values),
         cmocka_unit_test(test_absurd_frame_count),
         cmocka_unit_test(test_structure_errors),
+        cmocka_unit_test(test_no_channels),
         cmocka_unit_test(test_missing_file),
         cmocka_unit_test(test_hand_computed_fk),
         cmocka_unit_test(test_crlf_and_trailing_blanks),

@@ -16,6 +16,7 @@
 #include "candump_log.h"
 #include "dbc_decode.h"
 #include "dbc_parse.h"
+#include "pb_warn.h"
 
 static int parse(const char *line, pb_can_frame *f, const char **why)
 {
@@ -180,6 +181,55 @@ static void test_reader_bad_file(void **state)
     pb_candump_close(&r);
 }
 
+static void write_bytes(const char *path, const char *bytes, size_t n)
+{
+    FILE *w = fopen(path, "wb");
+    assert_non_null(w);
+    assert_int_equal(fwrite(bytes, 1, n, w), n);
+    fclose(w);
+}
+
+/* A NUL byte inside a line rejects that line alone, named by its number
+ * (fgets + strlen took it for an overlong line and swallowed the next, good,
+ * one); a last line without a newline was cut by a killed recorder: reported,
+ * not returned, not fatal. Every rejected line is a warning with its number. */
+static void test_reader_nul_and_cut_line(void **state)
+{
+    (void)state;
+    char path[1024];
+    snprintf(path, sizeof path, "%s/nul.log", getenv("POSE_TEST_TMP"));
+    static const char log[] = "(1.000000) can0 123#00\n"
+                              "(1.000001) can0 1\0" "24#01\n"
+                              "(1.000002) can0 125#02\n"
+                              "(1.000003) can0 126#03\n"
+                              "(1.000004) can0 127#0405";
+    write_bytes(path, log, sizeof log - 1);
+    pb_warnings w;
+    memset(&w, 0, sizeof w);
+    pb_warnings *prev = pb_warnings_install(&w);
+    pb_candump_reader r;
+    char err[256];
+    assert_int_equal(pb_candump_open(&r, path, err, sizeof err), 0);
+    pb_can_frame f;
+    const uint32_t want[] = {0x123, 0x125, 0x126};
+    for (size_t i = 0; i < 3; i++) {
+        assert_int_equal(pb_candump_next(&r, &f), 1);
+        assert_int_equal(f.id, want[i]);
+    }
+    assert_int_equal(pb_candump_next(&r, &f), 0);
+    pb_warnings_install(prev);
+    assert_int_equal(r.frames, 3);
+    assert_int_equal(r.bad_lines, 2);
+    assert_int_equal(r.line, 5);
+    assert_int_equal(w.count, 2);
+    if (!strstr(w.text[0], "nul.log:2: NUL byte in the line"))
+        fail_msg("%s", w.text[0]);
+    if (!strstr(w.text[1], "nul.log:5: last line cut (no newline at the end of the file)"))
+        fail_msg("%s", w.text[1]);
+    assert_non_null(strstr(r.last_error, "nul.log:5: last line cut"));
+    pb_candump_close(&r);
+}
+
 /* The real capture: every line parses; frames of DBC messages decode; count the lengths that disagree. */
 static void test_motec_capture(void **state)
 {
@@ -240,6 +290,7 @@ int main(void)
         cmocka_unit_test(test_frame_kinds),
         cmocka_unit_test(test_round_trip),
         cmocka_unit_test(test_reader_bad_file),
+        cmocka_unit_test(test_reader_nul_and_cut_line),
         cmocka_unit_test(test_motec_capture),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

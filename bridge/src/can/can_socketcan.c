@@ -38,12 +38,8 @@ static void set_opt(int fd, int level, int name, int value)
     (void)setsockopt(fd, level, name, &value, sizeof value);
 }
 
-int pb_can_socket_open(const char *iface, const pb_can_filter *filters, size_t count, pb_error *err)
+static int socketcan_open(const char *iface, const pb_can_filter *filters, size_t count, pb_error *err)
 {
-    if (!iface || strlen(iface) >= IFNAMSIZ) {
-        pb_fail(err, POSE_ERR_INVALID_ARGUMENT, "CAN: bad interface name");
-        return -1;
-    }
     int fd = socket(PF_CAN, SOCK_RAW | SOCK_CLOEXEC, CAN_RAW);
     if (fd < 0) {
         pb_fail(err, POSE_ERR_IO, "CAN: socket(PF_CAN): %s", strerror(errno));
@@ -97,17 +93,27 @@ int pb_can_socket_open(const char *iface, const pb_can_filter *filters, size_t c
     return fd;
 }
 
+static pb_can_socket_opener opener = socketcan_open;
+
+void pb_can_set_socket_opener(pb_can_socket_opener fn) { opener = fn ? fn : socketcan_open; }
+
+int pb_can_socket_open(const char *iface, const pb_can_filter *filters, size_t count, pb_error *err)
+{
+    if (!iface || strlen(iface) >= IFNAMSIZ) {
+        pb_fail(err, POSE_ERR_INVALID_ARGUMENT, "CAN: bad interface name");
+        return -1;
+    }
+    return opener(iface, filters, count, err);
+}
+
 static void live_record(can_live *s, const pb_can_frame *f, int64_t real_ns)
 {
     if (!s->record)
         return;
     pb_can_frame w = *f;
     w.t_ns = real_ns;
-    char line[PB_CANDUMP_LINE_MAX];
-    int n = pb_candump_format(&w, s->iface[0] ? s->iface : "can0", line, sizeof line);
-    /* Flushed per frame so a crash loses at most the last one; on a write
-     * error (disk full) recording stops and the pose keeps running. */
-    if (n > 0 && (fwrite(line, 1, (size_t)n, s->record) != (size_t)n || fflush(s->record) != 0)) {
+    /* On a write error (disk full) recording stops and the pose keeps running. */
+    if (pb_candump_write(s->record, &w, s->iface[0] ? s->iface : "can0") != 0) {
         fclose(s->record);
         s->record = NULL;
     }

@@ -41,6 +41,16 @@ pose_status pb_can_live_open_fd(int fd, int own_fd, const char *label, pb_can_bu
 /** Raw CAN socket bound to iface with the given filters (none: everything). -1 with err on failure. */
 int pb_can_socket_open(const char *iface, const pb_can_filter *filters, size_t count, pb_error *err);
 
+/** What pb_can_socket_open calls to open an interface by name. */
+typedef int (*pb_can_socket_opener)(const char *iface, const pb_can_filter *filters, size_t count, pb_error *err);
+/**
+ * Replace the SocketCAN opener (NULL restores it). For tests: containers have
+ * no vcan, and a stand-in that hands out socketpair ends exercises the paths
+ * that need an interface name (the live source's reopen after the interface
+ * went away). Set it before opening sources; it is not synchronised.
+ */
+void pb_can_set_socket_opener(pb_can_socket_opener fn);
+
 /** Options of the replay; zero means default. */
 typedef struct pb_candump_replay_options {
     int as_fast_as_possible; /**< ignore recorded timing */

@@ -10,6 +10,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pb_warn.h"
+
+#define PB_STR_(x) #x
+#define PB_STR(x) PB_STR_(x)
+
 static int hexval(char c)
 {
     if (c >= '0' && c <= '9')
@@ -252,6 +257,17 @@ int pb_candump_format(const pb_can_frame *f, const char *iface, char *buf, size_
     return (int)w;
 }
 
+int pb_candump_write(FILE *out, const pb_can_frame *f, const char *iface)
+{
+    char line[PB_CANDUMP_LINE_MAX];
+    const int n = pb_candump_format(f, iface, line, sizeof line);
+    if (n < 0) {
+        errno = EINVAL;
+        return -1;
+    }
+    return fwrite(line, 1, (size_t)n, out) == (size_t)n && fflush(out) == 0 ? 0 : -1;
+}
+
 int pb_candump_open(pb_candump_reader *r, const char *path, char *err, size_t err_size)
 {
     memset(r, 0, sizeof *r);
@@ -272,31 +288,64 @@ int pb_candump_open(pb_candump_reader *r, const char *path, char *err, size_t er
     return 0;
 }
 
+/* One line into buf by length: fgets + strlen would stop at a NUL byte and
+ * take the rest of the line (or the next one) for a line of its own. Returns
+ * 0 at the end of the file, else 1 with *n bytes kept (the newline not
+ * included), *terminated when a newline ended it, *nul when it held a NUL
+ * and *overlong when it had more than `cap` bytes (the rest is consumed). */
+static int read_line(FILE *file, char *buf, size_t cap, size_t *n, int *terminated, int *nul, int *overlong)
+{
+    int c;
+    size_t len = 0, total = 0;
+    *terminated = *nul = 0;
+    while ((c = getc(file)) != EOF) {
+        if (c == '\n') {
+            *terminated = 1;
+            break;
+        }
+        if (c == '\0')
+            *nul = 1;
+        if (len < cap)
+            buf[len++] = (char)c;
+        total++;
+    }
+    *n = len;
+    *overlong = total > cap;
+    return total > 0 || *terminated;
+}
+
+static void reject(pb_candump_reader *r, const char *why, const char *cut)
+{
+    r->bad_lines++;
+    snprintf(r->last_error, sizeof r->last_error, "%s:%zu: %s%s", r->path, r->line, cut, why);
+    pb_warn("%s", r->last_error);
+}
+
 int pb_candump_next(pb_candump_reader *r, pb_can_frame *f)
 {
-    char buf[PB_CANDUMP_LINE_MAX + 2];
-    while (fgets(buf, sizeof buf, r->file)) {
-        size_t n = strlen(buf);
+    char buf[PB_CANDUMP_LINE_MAX];
+    size_t n;
+    int terminated, nul, overlong;
+    while (read_line(r->file, buf, sizeof buf, &n, &terminated, &nul, &overlong)) {
         r->line++;
+        /* candump ends every line with a newline: a last line without one was
+         * cut short (a recorder killed mid-write), whatever it parses as. */
+        const char *cut = terminated ? "" : "last line cut (no newline at the end of the file): ";
         const char *why = NULL;
-        int rc;
-        if (n > 0 && buf[n - 1] != '\n' && !feof(r->file)) {
-            /* An overlong line is garbage whatever it holds: drop the rest of it. */
-            int c;
-            while ((c = fgetc(r->file)) != EOF && c != '\n')
-                ;
-            why = "line too long";
-            rc = -1;
-        } else {
-            rc = pb_candump_parse_line(buf, n, f, r->iface, sizeof r->iface, &why);
-        }
-        if (rc == 1) {
-            r->frames++;
-            return 1;
-        }
-        if (rc < 0) {
-            r->bad_lines++;
-            snprintf(r->last_error, sizeof r->last_error, "%s:%zu: %s", r->path, r->line, why);
+        if (overlong)
+            reject(r, "line too long (over " PB_STR(PB_CANDUMP_LINE_MAX) " bytes)", cut);
+        else if (nul)
+            reject(r, "NUL byte in the line", cut);
+        else if (!terminated)
+            reject(r, "skipped", cut);
+        else {
+            int rc = pb_candump_parse_line(buf, n, f, r->iface, sizeof r->iface, &why);
+            if (rc == 1) {
+                r->frames++;
+                return 1;
+            }
+            if (rc < 0)
+                reject(r, why, cut);
         }
     }
     return ferror(r->file) ? -1 : 0;

@@ -30,6 +30,13 @@ int pb_candump_parse_line(const char *line, size_t len, pb_can_frame *f, char *i
 /** Format f as a candump -l line with newline. Returns the length, or -1 if size is too small. */
 int pb_candump_format(const pb_can_frame *f, const char *iface, char *buf, size_t size);
 
+/**
+ * Write f as a candump -l line and flush it, so that a crash or a kill loses
+ * at most this frame (recorders call it once per frame). Returns 0, or -1
+ * on a write error (errno set).
+ */
+int pb_candump_write(FILE *out, const pb_can_frame *f, const char *iface);
+
 /** Sequential reader over a log file. */
 typedef struct pb_candump_reader {
     FILE *file;
@@ -45,8 +52,11 @@ typedef struct pb_candump_reader {
 int pb_candump_open(pb_candump_reader *r, const char *path, char *err, size_t err_size);
 
 /**
- * Next frame. Malformed lines are counted, described in last_error and
- * skipped. Returns 1 with *f, 0 at the end of the file, -1 on a read error.
+ * Next frame. Lines are read by length (a NUL byte spoils its own line
+ * only). Malformed lines, and a last line without its newline (cut by a
+ * killed recorder), are counted, described in last_error, reported with
+ * pb_warn naming the file and line, and skipped. Returns 1 with *f, 0 at the
+ * end of the file, -1 on a read error.
  */
 int pb_candump_next(pb_candump_reader *r, pb_can_frame *f);
 

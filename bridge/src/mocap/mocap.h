@@ -75,9 +75,13 @@ pose_status pb_clip_load(const char *path, const char *skeleton, pb_clip **out, 
 void pb_clip_free(pb_clip *clip);
 /** Index of the joint with this exact name, or -1. */
 int pb_clip_find_joint(const pb_clip *clip, const char *name);
-/** Frame f's values (f < frame_count). */
+/** Frame f's values (f < frame_count); NULL for a clip without channels (its reference pose). */
 static inline const double *pb_clip_frame(const pb_clip *clip, size_t f)
 {
+    /* A clip without channels (BVH "CHANNELS 0" everywhere) has no frame
+     * storage: frames is NULL, and NULL + 0 is undefined behaviour. */
+    if (!clip->frames)
+        return NULL;
     return clip->frames + f * (size_t)clip->channel_count;
 }
 
