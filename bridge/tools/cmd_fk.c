@@ -82,13 +82,17 @@ static int run(int argc, char **argv)
         return 1;
     }
     int rc = 0;
-    for (size_t i = 0; i < nf; i++)
+    if (clip->frame_count == 0) /* an ASF alone: a skeleton, its motion is in an AMC file */
+        fprintf(stderr, "pose-bridge fk: %s is a skeleton without motion: give the AMC file "
+                        "(pose-bridge fk TAKE.amc --skeleton %s)\n", file, file);
+    for (size_t i = 0; clip->frame_count && i < nf; i++)
         if ((size_t)frames[i] >= clip->frame_count) {
             fprintf(stderr, "pose-bridge fk: frame %ld is out of range (the clip has %zu frames)\n", frames[i],
                     clip->frame_count);
             rc = 1;
         }
     size_t J = (size_t)clip->joint_count;
+    rc |= clip->frame_count == 0;
     double *scratch = malloc(J * 7 * sizeof *scratch);
     double (*wq)[4] = malloc(J * sizeof *wq);
     double (*wp)[3] = malloc(J * sizeof *wp);

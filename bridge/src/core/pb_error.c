@@ -2,10 +2,12 @@
 #include "pb_error.h"
 
 #include <errno.h>
+#include <stdint.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 pose_status pb_fail(pb_error *err, pose_status status, const char *fmt, ...)
 {
@@ -25,17 +27,21 @@ pose_status pb_read_file(const char *path, size_t max_bytes, char **data, size_t
     FILE *f = fopen(path, "rb");
     if (!f)
         return pb_fail(err, POSE_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    if (fseek(f, 0, SEEK_END) != 0) {
+    /* fopen succeeds on a directory, whose "size" from fseek/ftell is LONG_MAX:
+     * say what the path is instead. */
+    struct stat st;
+    const int have = fstat(fileno(f), &st) == 0;
+    if (!have || !S_ISREG(st.st_mode)) {
+        const int dir = have && S_ISDIR(st.st_mode);
         fclose(f);
-        return pb_fail(err, POSE_ERR_IO, "%s: cannot seek: %s", path, strerror(errno));
+        return pb_fail(err, POSE_ERR_IO, "%s: %s", path, dir ? "is a directory, not a file" : "is not a regular file");
     }
-    long n = ftell(f);
-    if (n < 0 || (unsigned long)n > max_bytes) {
+    if ((uintmax_t)st.st_size > max_bytes) {
         fclose(f);
-        return pb_fail(err, POSE_ERR_IO, "%s: size %ld is not readable or above the limit of %zu bytes",
-                       path, n, max_bytes);
+        return pb_fail(err, POSE_ERR_IO, "%s: %jd bytes is above the limit of %zu bytes", path,
+                       (intmax_t)st.st_size, max_bytes);
     }
-    rewind(f);
+    const long n = (long)st.st_size;
     char *buf = malloc((size_t)n + 1);
     if (!buf) {
         fclose(f);

@@ -10,9 +10,14 @@
 pose_status pb_player_init(pb_player *p, const pb_clip *clip, int loop, pb_error *err)
 {
     memset(p, 0, sizeof *p);
-    if (!clip || clip->frame_count == 0)
-        return pb_fail(err, POSE_ERR_INVALID_ARGUMENT, "%s: the clip has no frames to play",
-                       clip ? clip->path : "(null)");
+    if (!clip)
+        return pb_fail(err, POSE_ERR_INVALID_ARGUMENT, "pb_player_init: no clip");
+    if (clip->frame_count == 0 && strcmp(clip->format, "asf-amc") == 0) /* an ASF loaded alone */
+        return pb_fail(err, POSE_ERR_INVALID_ARGUMENT,
+                       "%s is a skeleton without motion: open its AMC file (with the ASF as the skeleton)",
+                       clip->path);
+    if (clip->frame_count == 0)
+        return pb_fail(err, POSE_ERR_INVALID_ARGUMENT, "%s: the clip has no frames to play", clip->path);
     size_t n = (size_t)(clip->joint_count > 0 ? clip->joint_count : 1);
     p->clip = clip;
     p->loop = loop;
