@@ -6,11 +6,13 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <cmocka.h>
 
 #include "hid_mannequin.h"
+#include "hid_recorder.h"
 #include "hid_report.h"
 #include "pb_warn.h"
 
@@ -554,6 +556,188 @@ static void test_kernel_tolerated_items(void **state)
     pb_warnings_install(prev);
 }
 
+/* A real device with the trailing 0x00: the Apple Wireless Keyboard over
+ * Bluetooth (05ac:0256), data/hid/real/apple_wireless_keyboard_bt.hid
+ * (provenance in data/hid/real/README.md). Its 225-byte descriptor ends
+ * "... b1 01 c0 00": the 0x00 at byte 224 is a main item with tag 0, which
+ * hid-core.c's hid_parser_main answers with hid_warn("unknown main item tag
+ * 0x0") and return 0, so hid_open_report finishes the descriptor normally.
+ * The expected values below were worked out by hand from hid-core.c
+ * (hid_parser_global/_local/_main, hid_add_field, hid_concatenate_last_usage_page)
+ * walked over the bytes; the kernel's own selftest for this keyboard
+ * (tools/testing/selftests/hid/tests/test_apple_keyboard.py) carries bytes
+ * 0-223, and its test_single_fn_function_key drives the 0xff0003 bit used below. */
+static void test_real_trailing_zero(void **state)
+{
+    (void)state;
+    const char *dir = getenv("POSE_DATA_DIR");
+    assert_non_null(dir);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/hid/real/apple_wireless_keyboard_bt.hid", dir);
+    pb_hid_recording *rec = NULL;
+    pb_error err = {{0}};
+    if (pb_hid_recording_load(path, &rec, &err) != POSE_OK)
+        fail_msg("%s", err.message);
+    assert_int_equal(rec->device_count, 1);
+    const pb_hid_rec_device *dev = &rec->devices[0];
+    assert_string_equal(dev->name, "Apple Wireless Keyboard");
+    assert_int_equal(dev->bus, 5); /* BUS_BLUETOOTH */
+    assert_int_equal(dev->vendor, 0x05ac);
+    assert_int_equal(dev->product, 0x0256);
+    assert_int_equal(dev->desc_len, 225);
+    assert_int_equal(dev->desc[223], 0xC0); /* the last End Collection */
+    assert_int_equal(dev->desc[224], 0x00);
+
+    pb_warnings w = {0};
+    pb_warnings *prev = pb_warnings_install(&w);
+    pb_hid_desc *d = NULL;
+    if (pb_hid_desc_parse(dev->desc, dev->desc_len, "apple_wireless_keyboard_bt.hid", &d, &err) != POSE_OK)
+        fail_msg("%s", err.message);
+    assert_int_equal(w.count, 1); /* the kernel warns once, for byte 224 */
+    assert_string_equal(w.text[0], "apple_wireless_keyboard_bt.hid: report descriptor byte 224: 1 trailing 0x00 byte "
+                                   "after the last item skipped, as the Linux kernel does");
+
+    /* Collections (the kernel's device->collection[], 4 of them): Application
+     * Keyboard; Application Consumer Control holding a Logical Keyboard (usage
+     * 0x00010006: Usage Page 0x01 is current at byte 77); Application Consumer Control. */
+    assert_int_equal(d->collection_count, 4);
+    const uint32_t col_usage[4] = {0x00010006, 0x000C0001, 0x00010006, 0x000C0001};
+    const uint8_t col_type[4] = {1, 1, 2, 1};
+    const int32_t col_parent[4] = {-1, -1, 1, -1};
+    for (int i = 0; i < 4; i++) {
+        assert_int_equal(d->collections[i].usage, col_usage[i]);
+        assert_int_equal(d->collections[i].type, col_type[i]);
+        assert_int_equal(d->collections[i].parent, col_parent[i]);
+    }
+
+    /* Report sizes (the kernel's report->size, bits, without the ID byte):
+     * input 1 = 8 x 1 modifiers + 8 constant + 6 x 8 keys = 64; output 1 = 5 LEDs
+     * + 3 constant = 8; inputs 17, 18, 19 and 71 = 8 each; feature 9 = 8 + 16 = 24. */
+    assert_true(d->uses_report_ids);
+    assert_int_equal(d->input_bytes[1], 8);
+    assert_int_equal(pb_hid_desc_input_length(d, 1), 9);
+    assert_int_equal(d->output_bytes[1], 1);
+    assert_int_equal(d->input_bytes[17], 1);
+    assert_int_equal(d->input_bytes[18], 1);
+    assert_int_equal(d->input_bytes[19], 1);
+    assert_int_equal(d->input_bytes[71], 1);
+    assert_int_equal(d->feature_bytes[9], 3);
+    assert_int_equal(d->input_bytes[9], 0);
+
+    /* The kernel makes 14 fields (hid_add_field skips the 9 constant items, which
+     * only advance report->size): input 1: modifiers (report_count 8, usages
+     * 0x700e0-0x700e7) and keys (array, report_count 6, 256 usages 0x70000-0x700ff,
+     * logical 0..255); output 1: LEDs (5 usages 0x80001-0x80005); input 71: Battery
+     * Strength 0x60020; input 17: Eject 0xc00b8 at bit 3, 0xff0003 at bit 4 (Usage
+     * Page 0x00ff); input 18: 0xc00cd, 0xc00b3, 0xc00b4, 0xc00b5, 0xc00b6 at bits
+     * 0-4; input 19: 0xff01000a, 0xff01000c (Input 0x22: NoPref); feature 9: 0xff01000b.
+     * Here one pb_hid_field is one value (report_count of them per kernel field) and
+     * the constant items are kept as padding: 30 values + 9 padding = 39; the 24
+     * input values are the channels. */
+    assert_int_equal(d->field_count, 39);
+    assert_int_equal(d->channel_count, 24);
+    for (int c = 0; c < 8; c++) {
+        const pb_hid_field *f = &d->fields[d->channel_field[c]];
+        assert_int_equal(f->report_id, 1);
+        assert_int_equal(f->usage, 0x000700E0u + (uint32_t)c);
+        assert_int_equal(f->bit_offset, (uint32_t)c);
+        assert_int_equal(f->bit_size, 1);
+    }
+    for (int c = 8; c < 14; c++) {
+        const pb_hid_field *f = &d->fields[d->channel_field[c]];
+        assert_false(f->flags & PB_HID_VARIABLE);
+        assert_int_equal(f->usage, 0x00070000);
+        assert_int_equal(f->usage_last, 0x000700FF);
+        assert_int_equal(f->array_index, (uint32_t)(c - 8));
+        assert_int_equal(f->bit_offset, 16 + 8 * (uint32_t)(c - 8));
+        assert_int_equal(f->logical_min, 0);
+        assert_int_equal(f->logical_max, 255);
+    }
+    static const struct { uint8_t id; uint32_t usage, bit; uint16_t flags; } rest[] = {
+        {17, 0x000C00B8, 3, 0x02}, {17, 0x00FF0003, 4, 0x02}, {18, 0x000C00CD, 0, 0x02},
+        {18, 0x000C00B3, 1, 0x02}, {18, 0x000C00B4, 2, 0x02}, {18, 0x000C00B5, 3, 0x02},
+        {18, 0x000C00B6, 4, 0x02}, {19, 0xFF01000A, 0, 0x02}, {19, 0xFF01000C, 1, 0x22},
+        {71, 0x00060020, 0, 0x02},
+    };
+    for (int i = 0; i < 10; i++) {
+        const pb_hid_field *f = &d->fields[d->channel_field[14 + i]];
+        assert_int_equal(f->kind, PB_HID_INPUT);
+        assert_int_equal(f->report_id, rest[i].id);
+        assert_int_equal(f->usage, rest[i].usage);
+        assert_int_equal(f->bit_offset, rest[i].bit);
+        assert_int_equal(f->flags, rest[i].flags);
+    }
+    assert_int_equal(d->fields[d->channel_field[23]].logical_max, 255); /* battery 0..255 */
+    assert_int_equal(d->fields[d->channel_field[23]].collection, 2);   /* inside the Logical one */
+    int leds = 0, feature = 0;
+    for (size_t i = 0; i < d->field_count; i++) {
+        const pb_hid_field *f = &d->fields[i];
+        if (f->kind == PB_HID_OUTPUT && !(f->flags & PB_HID_CONSTANT)) {
+            assert_int_equal(f->usage, 0x00080001u + (uint32_t)leds);
+            leds++;
+        } else if (f->kind == PB_HID_FEATURE && !(f->flags & PB_HID_CONSTANT)) {
+            assert_int_equal(f->report_id, 9);
+            assert_int_equal(f->usage, 0xFF01000B);
+            feature++;
+        }
+    }
+    assert_int_equal(leds, 5);
+    assert_int_equal(feature, 1);
+
+    /* Reports laid out by that descriptor (authored here): Left Shift with 'a'
+     * and 's' held, then the fn key (report 17 bit 4, as the kernel selftest's
+     * send_fn_state sets it), then a battery level. */
+    int32_t lg[24];
+    double v[24];
+    uint8_t ok[24];
+    uint32_t first, count;
+    const uint8_t keys[9] = {0x01, 0x02, 0x00, 0x04, 0x16, 0x00, 0x00, 0x00, 0x00};
+    assert_int_equal(pb_hid_report_decode(d, keys, sizeof keys, lg, v, ok, &first, &count), PB_HID_DECODE_OK);
+    assert_int_equal(first, 0);
+    assert_int_equal(count, 14);
+    for (int c = 0; c < 8; c++)
+        assert_int_equal(lg[c], c == 1); /* 0xE1 Left Shift */
+    assert_int_equal(lg[8], 0x04);
+    assert_int_equal(lg[9], 0x16);
+    for (int c = 10; c < 14; c++)
+        assert_int_equal(lg[c], 0);
+    const uint8_t fn[2] = {0x11, 0x10};
+    assert_int_equal(pb_hid_report_decode(d, fn, sizeof fn, lg, v, ok, &first, &count), PB_HID_DECODE_OK);
+    assert_int_equal(first, 14);
+    assert_int_equal(count, 2);
+    assert_int_equal(lg[14], 0);
+    assert_int_equal(lg[15], 1);
+    const uint8_t battery[2] = {0x47, 0x64};
+    assert_int_equal(pb_hid_report_decode(d, battery, sizeof battery, lg, v, ok, &first, &count), PB_HID_DECODE_OK);
+    assert_int_equal(first, 23);
+    assert_int_equal(count, 1);
+    assert_int_equal(lg[23], 100);
+    const uint8_t feature_id[4] = {0x09, 0x00, 0x00, 0x00};
+    assert_int_equal(pb_hid_report_decode(d, feature_id, sizeof feature_id, lg, v, ok, &first, &count),
+                     PB_HID_DECODE_UNKNOWN_ID);
+
+    /* Without byte 224 (the kernel selftest's 224 bytes): no warning, the same fields. */
+    w.count = 0;
+    pb_hid_desc *d224 = parse_ok(dev->desc, 224);
+    assert_int_equal(w.count, 0);
+    assert_int_equal(d224->field_count, d->field_count);
+    assert_int_equal(d224->channel_count, d->channel_count);
+    for (size_t i = 0; i < d->field_count; i++) {
+        const pb_hid_field *a = &d->fields[i], *b = &d224->fields[i];
+        assert_int_equal(a->kind, b->kind);
+        assert_int_equal(a->report_id, b->report_id);
+        assert_int_equal(a->flags, b->flags);
+        assert_int_equal(a->bit_offset, b->bit_offset);
+        assert_int_equal(a->bit_size, b->bit_size);
+        assert_int_equal(a->usage, b->usage);
+        assert_int_equal(a->usage_last, b->usage_last);
+    }
+    pb_hid_desc_free(d224);
+    pb_hid_desc_free(d);
+    pb_hid_recording_free(rec);
+    pb_warnings_install(prev);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -567,6 +751,7 @@ int main(void)
         cmocka_unit_test(test_unaligned_32bit),
         cmocka_unit_test(test_mannequin),
         cmocka_unit_test(test_kernel_tolerated_items),
+        cmocka_unit_test(test_real_trailing_zero),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
