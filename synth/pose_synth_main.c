@@ -7,6 +7,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "pose_cli.h"
 #include "pose_synth.h"
 
 static void usage(FILE *f)
@@ -90,41 +91,53 @@ int main(int argc, char **argv)
     int bones = 0, json = 0;
     long long tets = 0;
     pose_synth_cor_mode cor = POSE_SYNTH_COR_AUTO;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+    enum { OPT_BONES = POSE_CLI_LONG_ONLY, OPT_TETS, OPT_COR, OPT_JSON };
+    static const struct option options[] = {
+        {"output", required_argument, NULL, 'o'}, {"bones", required_argument, NULL, OPT_BONES},
+        {"tets", required_argument, NULL, OPT_TETS}, {"cor", required_argument, NULL, OPT_COR},
+        {"json", no_argument, NULL, OPT_JSON},      {"help", no_argument, NULL, 'h'},
+        {0}};
+    pose_cli cli;
+    pose_cli_begin(&cli, "pose-synth", argc, argv, options);
+    long n;
+    for (int c; (c = pose_cli_next(&cli)) != POSE_CLI_END;) {
+        switch (c) {
+        case 'h':
             usage(stdout);
             return 0;
-        } else if (!strcmp(a, "--json")) {
+        case OPT_JSON:
             json = 1;
-        } else if ((!strcmp(a, "-o") || !strcmp(a, "--output")) && i + 1 < argc) {
-            path = argv[++i];
-        } else if (!strcmp(a, "--bones") && i + 1 < argc) {
-            bones = atoi(argv[++i]);
-            if (bones < 1 || bones > 64) {
-                fprintf(stderr, "pose-synth: --bones must be 1..64\n");
+            break;
+        case 'o':
+            path = cli.value;
+            break;
+        case OPT_BONES:
+            if (pose_cli_long(&cli, 1, 64, &n) < 0)
                 return 2;
-            }
-        } else if (!strcmp(a, "--tets") && i + 1 < argc) {
-            tets = atoll(argv[++i]);
-            if (tets < 1000) {
-                fprintf(stderr, "pose-synth: --tets must be at least 1000\n");
+            bones = (int)n;
+            break;
+        case OPT_TETS:
+            if (pose_cli_long(&cli, 1000, 1000000000, &n) < 0)
                 return 2;
-            }
-        } else if (!strcmp(a, "--cor") && i + 1 < argc) {
-            const char *m = argv[++i];
-            cor = !strcmp(m, "exact") ? POSE_SYNTH_COR_EXACT
-                : !strcmp(m, "clustered") ? POSE_SYNTH_COR_CLUSTERED
-                : !strcmp(m, "none") ? POSE_SYNTH_COR_NONE : POSE_SYNTH_COR_AUTO;
+            tets = n;
+            break;
+        case OPT_COR:
+            cor = !strcmp(cli.value, "exact") ? POSE_SYNTH_COR_EXACT
+                : !strcmp(cli.value, "clustered") ? POSE_SYNTH_COR_CLUSTERED
+                : !strcmp(cli.value, "none") ? POSE_SYNTH_COR_NONE : POSE_SYNTH_COR_AUTO;
             if (cor == POSE_SYNTH_COR_AUTO) {
-                fprintf(stderr, "pose-synth: --cor must be exact, clustered or none\n");
+                pose_cli_error(&cli, "--cor must be exact, clustered or none");
                 return 2;
             }
-        } else if (a[0] != '-' && !kind) {
-            kind = a;
-        } else {
-            fprintf(stderr, "pose-synth: unexpected argument '%s'\n", a);
-            usage(stderr);
+            break;
+        case POSE_CLI_ARGUMENT:
+            if (kind) {
+                pose_cli_error(&cli, "unexpected argument '%s'", cli.value);
+                return 2;
+            }
+            kind = cli.value;
+            break;
+        default: /* POSE_CLI_ERROR: reported */
             return 2;
         }
     }

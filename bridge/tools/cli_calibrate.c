@@ -16,6 +16,7 @@
 
 #include "calibrate.h"
 #include "pose_bridge_cli.h"
+#include "pose_cli.h"
 
 static void usage(FILE *f, const pb_cli_calibrate_kind *k)
 {
@@ -40,49 +41,84 @@ typedef struct calib_args {
     double angle[2], at[2];
 } calib_args;
 
+/* 0, 1 after --help, or 2 (reported). */
 static int parse_args(int argc, char **argv, const pb_cli_calibrate_kind *k, calib_args *a)
 {
+    enum { OPT_MAP = POSE_CLI_LONG_ONLY, OPT_CHANNEL, OPT_ENTRY, OPT_SAMPLES, OPT_NEUTRAL, OPT_ANGLES, OPT_AT,
+           OPT_JSON };
+    static const struct option options[] = {
+        {"map", required_argument, NULL, OPT_MAP},         {"channel", required_argument, NULL, OPT_CHANNEL},
+        {"entry", required_argument, NULL, OPT_ENTRY},     {"samples", required_argument, NULL, OPT_SAMPLES},
+        {"neutral", no_argument, NULL, OPT_NEUTRAL},       {"angles", required_argument, NULL, OPT_ANGLES},
+        {"at", required_argument, NULL, OPT_AT},           {"json", no_argument, NULL, OPT_JSON},
+        {"help", no_argument, NULL, 'h'},                  {0}};
+    char tool[64];
+    snprintf(tool, sizeof tool, "pose-bridge %s", k->command);
     *a = (calib_args){.entry = -1, .samples = 50, .angle = {0, 90}};
-    for (int i = 1; i < argc; i++) {
-        const int more = i + 1 < argc;
-        if (strcmp(argv[i], "--map") == 0 && more)
-            a->map = argv[++i];
-        else if (strcmp(argv[i], "--channel") == 0 && more)
-            a->name = argv[++i];
-        else if (strcmp(argv[i], "--entry") == 0 && more)
-            a->entry = atoi(argv[++i]);
-        else if (strcmp(argv[i], "--samples") == 0 && more)
-            a->samples = atoi(argv[++i]);
-        else if (strcmp(argv[i], "--neutral") == 0)
+    pose_cli cli;
+    pose_cli_begin(&cli, tool, argc, argv, options);
+    long n;
+    for (int c; (c = pose_cli_next(&cli)) != POSE_CLI_END;)
+        switch (c) {
+        case 'h':
+            usage(stdout, k);
+            return 1;
+        case OPT_MAP:
+            a->map = cli.value;
+            break;
+        case OPT_CHANNEL:
+            a->name = cli.value;
+            break;
+        case OPT_ENTRY:
+            if (pose_cli_long(&cli, 0, 100000, &n) < 0)
+                return 2;
+            a->entry = (int)n;
+            break;
+        case OPT_SAMPLES:
+            if (pose_cli_long(&cli, 1, 1000000, &n) < 0)
+                return 2;
+            a->samples = (int)n;
+            break;
+        case OPT_NEUTRAL:
             a->neutral = 1;
-        else if (strcmp(argv[i], "--angles") == 0 && more) {
-            if (sscanf(argv[++i], "%lf,%lf", &a->angle[0], &a->angle[1]) != 2) {
-                fprintf(stderr, "pose-bridge %s: --angles wants A0,A1\n", k->command);
+            break;
+        case OPT_ANGLES:
+            if (sscanf(cli.value, "%lf,%lf", &a->angle[0], &a->angle[1]) != 2) {
+                pose_cli_error(&cli, "--angles wants A0,A1");
                 return 2;
             }
-        } else if (strcmp(argv[i], "--at") == 0 && more) {
-            int n = sscanf(argv[++i], "%lf,%lf", &a->at[0], &a->at[1]);
-            if (n < 1) {
-                fprintf(stderr, "pose-bridge %s: --at wants T0,T1 (or T with --neutral) in seconds\n", k->command);
+            break;
+        case OPT_AT:
+            a->have_at = sscanf(cli.value, "%lf,%lf", &a->at[0], &a->at[1]);
+            if (a->have_at < 1) {
+                pose_cli_error(&cli, "--at wants T0,T1 (or T with --neutral) in seconds");
                 return 2;
             }
-            a->have_at = n;
-        } else if (strcmp(argv[i], "--json") == 0)
+            break;
+        case OPT_JSON:
             a->json = 1;
-        else if (argv[i][0] != '-' && !a->spec)
-            a->spec = argv[i];
-        else {
-            fprintf(stderr, "pose-bridge %s: %s '%s'\n", k->command,
-                    argv[i][0] == '-' && !more ? "option needs a value or is unknown:" : "unexpected argument",
-                    argv[i]);
-            usage(stderr, k);
+            break;
+        case POSE_CLI_ARGUMENT:
+            if (a->spec) {
+                pose_cli_error(&cli, "unexpected argument '%s' (one source only)", cli.value);
+                return 2;
+            }
+            a->spec = cli.value;
+            break;
+        default: /* POSE_CLI_ERROR: reported */
             return 2;
         }
-    }
     const int one = a->name || a->entry >= 0;
-    if (!a->spec || !a->map || one == a->neutral || a->samples < 1 || (one && a->angle[0] == a->angle[1]) ||
-        (one && a->have_at == 1)) {
-        usage(stderr, k);
+    if (!a->spec || !a->map || one == a->neutral) {
+        pose_cli_error(&cli, "SOURCE, --map and one of --neutral, --channel, --entry are required");
+        return 2;
+    }
+    if (one && a->angle[0] == a->angle[1]) {
+        pose_cli_error(&cli, "--angles: the two angles must differ");
+        return 2;
+    }
+    if (one && a->have_at == 1) {
+        pose_cli_error(&cli, "--at: --channel and --entry measure at two times, T0,T1");
         return 2;
     }
     return 0;
@@ -223,14 +259,10 @@ static int calibrate_one(pb_source *src, const calib_args *a, const pb_cli_calib
 
 int pb_cli_calibrate(int argc, char **argv, const pb_cli_calibrate_kind *k)
 {
-    if (pb_cli_wants_help(argc, argv)) {
-        usage(stdout, k);
-        return 0;
-    }
     calib_args a;
     int rc = parse_args(argc, argv, k, &a);
     if (rc)
-        return rc;
+        return rc == 1 ? 0 : rc;
     pb_error err;
     pb_source *src = NULL;
     if (k->open(a.spec, a.map, a.have_at, &src, &err) != POSE_OK) {

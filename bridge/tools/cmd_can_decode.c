@@ -15,6 +15,7 @@
 #include "candump_log.h"
 #include "dbc_decode.h"
 #include "pose_bridge_cli.h"
+#include "pose_cli.h"
 
 static void help(FILE *f)
 {
@@ -60,31 +61,44 @@ static void print_head(const pb_can_frame *f, int json, const char *name)
 
 static int run(int argc, char **argv)
 {
-    if (pb_cli_wants_help(argc, argv)) {
-        help(stdout);
-        return 0;
-    }
+    enum { OPT_DBC = POSE_CLI_LONG_ONLY, OPT_BUS, OPT_JSON, OPT_ALL };
+    static const struct option options[] = {
+        {"dbc", required_argument, NULL, OPT_DBC}, {"bus", required_argument, NULL, OPT_BUS},
+        {"json", no_argument, NULL, OPT_JSON},     {"all", no_argument, NULL, OPT_ALL},
+        {"help", no_argument, NULL, 'h'},          {0}};
     const char *dbc_path = NULL, *bus_path = NULL, *log = NULL;
     int json = 0, all = 0;
-    for (int i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "--dbc") == 0 && i + 1 < argc)
-            dbc_path = argv[++i];
-        else if (strcmp(argv[i], "--bus") == 0 && i + 1 < argc)
-            bus_path = argv[++i];
-        else if (strcmp(argv[i], "--json") == 0)
+    pose_cli cli;
+    pose_cli_begin(&cli, "pose-bridge can-decode", argc, argv, options);
+    for (int c; (c = pose_cli_next(&cli)) != POSE_CLI_END;)
+        switch (c) {
+        case 'h':
+            help(stdout);
+            return 0;
+        case OPT_DBC:
+            dbc_path = cli.value;
+            break;
+        case OPT_BUS:
+            bus_path = cli.value;
+            break;
+        case OPT_JSON:
             json = 1;
-        else if (strcmp(argv[i], "--all") == 0)
+            break;
+        case OPT_ALL:
             all = 1;
-        else if (argv[i][0] != '-' && !log)
-            log = argv[i];
-        else {
-            fprintf(stderr, "pose-bridge can-decode: unexpected argument '%s'\n", argv[i]);
-            help(stderr);
+            break;
+        case POSE_CLI_ARGUMENT:
+            if (log) {
+                pose_cli_error(&cli, "unexpected argument '%s' (one log only)", cli.value);
+                return 2;
+            }
+            log = cli.value;
+            break;
+        default: /* POSE_CLI_ERROR: reported */
             return 2;
         }
-    }
     if (!log || !!dbc_path == !!bus_path) {
-        help(stderr);
+        pose_cli_error(&cli, "a candump log and one of --dbc, --bus are required");
         return 2;
     }
     pb_error err;

@@ -12,6 +12,7 @@
 #include "can_source.h"
 #include "canopen_decode.h"
 #include "pose_bridge_cli.h"
+#include "pose_cli.h"
 
 static volatile sig_atomic_t stop;
 
@@ -82,34 +83,50 @@ static void report(pb_source *src, pb_can_decoder *dec, uint64_t *last_frames, d
 
 static int run(int argc, char **argv)
 {
-    if (pb_cli_wants_help(argc, argv)) {
-        help(stdout);
-        return 0;
-    }
+    enum { OPT_LOG = POSE_CLI_LONG_ONLY, OPT_BUS, OPT_SECONDS, OPT_JSON, OPT_FAST };
+    static const struct option options[] = {
+        {"log", required_argument, NULL, OPT_LOG},         {"bus", required_argument, NULL, OPT_BUS},
+        {"seconds", required_argument, NULL, OPT_SECONDS}, {"json", no_argument, NULL, OPT_JSON},
+        {"fast", no_argument, NULL, OPT_FAST},             {"help", no_argument, NULL, 'h'},
+        {0}};
     const char *iface = NULL, *log = NULL, *bus_path = NULL;
     int json = 0, fast = 0;
     double seconds = 0;
-    for (int i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "--log") == 0 && i + 1 < argc)
-            log = argv[++i];
-        else if (strcmp(argv[i], "--bus") == 0 && i + 1 < argc)
-            bus_path = argv[++i];
-        else if (strcmp(argv[i], "--seconds") == 0 && i + 1 < argc)
-            seconds = atof(argv[++i]);
-        else if (strcmp(argv[i], "--json") == 0)
+    pose_cli cli;
+    pose_cli_begin(&cli, "pose-bridge can-monitor", argc, argv, options);
+    for (int c; (c = pose_cli_next(&cli)) != POSE_CLI_END;)
+        switch (c) {
+        case 'h':
+            help(stdout);
+            return 0;
+        case OPT_LOG:
+            log = cli.value;
+            break;
+        case OPT_BUS:
+            bus_path = cli.value;
+            break;
+        case OPT_SECONDS:
+            if (pose_cli_double(&cli, 0, 1e9, &seconds) < 0)
+                return 2;
+            break;
+        case OPT_JSON:
             json = 1;
-        else if (strcmp(argv[i], "--fast") == 0)
+            break;
+        case OPT_FAST:
             fast = 1;
-        else if (argv[i][0] != '-' && !iface)
-            iface = argv[i];
-        else {
-            fprintf(stderr, "pose-bridge can-monitor: unexpected argument '%s'\n", argv[i]);
-            help(stderr);
+            break;
+        case POSE_CLI_ARGUMENT:
+            if (iface) {
+                pose_cli_error(&cli, "unexpected argument '%s' (one interface only)", cli.value);
+                return 2;
+            }
+            iface = cli.value;
+            break;
+        default: /* POSE_CLI_ERROR: reported */
             return 2;
         }
-    }
     if (!bus_path || !!iface == !!log) {
-        help(stderr);
+        pose_cli_error(&cli, "--bus and one of IFACE, --log are required");
         return 2;
     }
     pb_error err;

@@ -8,6 +8,7 @@
 
 #include "dbc_parse.h"
 #include "pose_bridge_cli.h"
+#include "pose_cli.h"
 
 static void help(FILE *f)
 {
@@ -152,25 +153,33 @@ static void describe_text(const pb_dbc *d)
 
 static int run(int argc, char **argv)
 {
-    if (pb_cli_wants_help(argc, argv)) {
-        help(stdout);
-        return 0;
-    }
+    enum { OPT_JSON = POSE_CLI_LONG_ONLY };
+    static const struct option options[] = {
+        {"json", no_argument, NULL, OPT_JSON}, {"help", no_argument, NULL, 'h'}, {0}};
     const char *file = NULL;
     int json = 0;
-    for (int i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "--json") == 0)
+    pose_cli cli;
+    pose_cli_begin(&cli, "pose-bridge dbc-describe", argc, argv, options);
+    for (int c; (c = pose_cli_next(&cli)) != POSE_CLI_END;)
+        switch (c) {
+        case 'h':
+            help(stdout);
+            return 0;
+        case OPT_JSON:
             json = 1;
-        else if (argv[i][0] != '-' && !file)
-            file = argv[i];
-        else {
-            fprintf(stderr, "pose-bridge dbc-describe: unexpected argument '%s'\n", argv[i]);
-            help(stderr);
+            break;
+        case POSE_CLI_ARGUMENT:
+            if (file) {
+                pose_cli_error(&cli, "unexpected argument '%s' (one DBC only)", cli.value);
+                return 2;
+            }
+            file = cli.value;
+            break;
+        default: /* POSE_CLI_ERROR: reported */
             return 2;
         }
-    }
     if (!file) {
-        help(stderr);
+        pose_cli_error(&cli, "no DBC file given");
         return 2;
     }
     pb_dbc *d = NULL;

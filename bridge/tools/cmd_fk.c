@@ -7,6 +7,7 @@
 
 #include "mocap.h"
 #include "pose_bridge_cli.h"
+#include "pose_cli.h"
 
 static void help(FILE *f)
 {
@@ -43,29 +44,41 @@ static int parse_frames(const char *s, long **out, size_t *count)
 
 static int run(int argc, char **argv)
 {
-    if (pb_cli_wants_help(argc, argv)) {
-        help(stdout);
-        return 0;
-    }
+    enum { OPT_SKELETON = POSE_CLI_LONG_ONLY, OPT_FRAMES, OPT_JSON };
+    static const struct option options[] = {
+        {"skeleton", required_argument, NULL, OPT_SKELETON}, {"frames", required_argument, NULL, OPT_FRAMES},
+        {"json", no_argument, NULL, OPT_JSON},               {"help", no_argument, NULL, 'h'},
+        {0}};
     const char *file = NULL, *skeleton = NULL, *frames_arg = "0";
     int json = 0;
-    for (int i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "--skeleton") == 0 && i + 1 < argc)
-            skeleton = argv[++i];
-        else if (strcmp(argv[i], "--frames") == 0 && i + 1 < argc)
-            frames_arg = argv[++i];
-        else if (strcmp(argv[i], "--json") == 0)
+    pose_cli cli;
+    pose_cli_begin(&cli, "pose-bridge fk", argc, argv, options);
+    for (int c; (c = pose_cli_next(&cli)) != POSE_CLI_END;)
+        switch (c) {
+        case 'h':
+            help(stdout);
+            return 0;
+        case OPT_SKELETON:
+            skeleton = cli.value;
+            break;
+        case OPT_FRAMES:
+            frames_arg = cli.value;
+            break;
+        case OPT_JSON:
             json = 1;
-        else if (argv[i][0] != '-' && !file)
-            file = argv[i];
-        else {
-            fprintf(stderr, "pose-bridge fk: unexpected argument '%s'\n", argv[i]);
-            help(stderr);
+            break;
+        case POSE_CLI_ARGUMENT:
+            if (file) {
+                pose_cli_error(&cli, "unexpected argument '%s' (one clip only)", cli.value);
+                return 2;
+            }
+            file = cli.value;
+            break;
+        default: /* POSE_CLI_ERROR: reported */
             return 2;
         }
-    }
     if (!file) {
-        help(stderr);
+        pose_cli_error(&cli, "no clip given");
         return 2;
     }
     long *frames;

@@ -8,6 +8,7 @@
 #include "hid_recorder.h"
 #include "hid_report.h"
 #include "pose_bridge_cli.h"
+#include "pose_cli.h"
 
 static void usage(FILE *f)
 {
@@ -64,30 +65,44 @@ static void print_event(const pb_hid_desc *d, const pb_hid_rec_event *e, const u
 
 static int run(int argc, char **argv)
 {
-    if (pb_cli_wants_help(argc, argv)) {
-        usage(stdout);
-        return 0;
-    }
+    enum { OPT_JSON = POSE_CLI_LONG_ONLY, OPT_DEVICE, OPT_LIMIT };
+    static const struct option options[] = {
+        {"json", no_argument, NULL, OPT_JSON}, {"device", required_argument, NULL, OPT_DEVICE},
+        {"limit", required_argument, NULL, OPT_LIMIT}, {"help", no_argument, NULL, 'h'},
+        {0}};
     const char *path = NULL;
     int json = 0;
     long device = -1, limit = -1;
-    for (int i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "--json") == 0)
+    pose_cli cli;
+    pose_cli_begin(&cli, "pose-bridge hid-decode", argc, argv, options);
+    for (int c; (c = pose_cli_next(&cli)) != POSE_CLI_END;)
+        switch (c) {
+        case 'h':
+            usage(stdout);
+            return 0;
+        case OPT_JSON:
             json = 1;
-        else if (strcmp(argv[i], "--device") == 0 && i + 1 < argc)
-            device = strtol(argv[++i], NULL, 10);
-        else if (strcmp(argv[i], "--limit") == 0 && i + 1 < argc)
-            limit = strtol(argv[++i], NULL, 10);
-        else if (argv[i][0] != '-' && !path)
-            path = argv[i];
-        else {
-            fprintf(stderr, "pose-bridge hid-decode: unexpected argument '%s'\n", argv[i]);
-            usage(stderr);
+            break;
+        case OPT_DEVICE:
+            if (pose_cli_long(&cli, 0, 65535, &device) < 0)
+                return 2;
+            break;
+        case OPT_LIMIT:
+            if (pose_cli_long(&cli, 0, 1000000000, &limit) < 0)
+                return 2;
+            break;
+        case POSE_CLI_ARGUMENT:
+            if (path) {
+                pose_cli_error(&cli, "unexpected argument '%s' (one recording only)", cli.value);
+                return 2;
+            }
+            path = cli.value;
+            break;
+        default: /* POSE_CLI_ERROR: reported */
             return 2;
         }
-    }
     if (!path) {
-        usage(stderr);
+        pose_cli_error(&cli, "no hid-recorder file given");
         return 2;
     }
     static pb_warnings warnings;

@@ -8,6 +8,7 @@
 #include "hid_open.h"
 #include "hid_report.h"
 #include "pose_bridge_cli.h"
+#include "pose_cli.h"
 
 static void usage(FILE *f)
 {
@@ -217,32 +218,47 @@ done:
 
 static int run(int argc, char **argv)
 {
-    if (pb_cli_wants_help(argc, argv)) {
-        usage(stdout);
-        return 0;
-    }
+    enum { OPT_JSON = POSE_CLI_LONG_ONLY, OPT_LIST, OPT_DEVICE };
+    static const struct option options[] = {
+        {"json", no_argument, NULL, OPT_JSON}, {"list", no_argument, NULL, OPT_LIST},
+        {"device", required_argument, NULL, OPT_DEVICE}, {"help", no_argument, NULL, 'h'},
+        {0}};
     const char *spec = NULL;
     int json = 0, list = 0;
     unsigned device = 0;
-    for (int i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "--json") == 0)
+    long n;
+    pose_cli cli;
+    pose_cli_begin(&cli, "pose-bridge hid-describe", argc, argv, options);
+    for (int c; (c = pose_cli_next(&cli)) != POSE_CLI_END;)
+        switch (c) {
+        case 'h':
+            usage(stdout);
+            return 0;
+        case OPT_JSON:
             json = 1;
-        else if (strcmp(argv[i], "--list") == 0)
+            break;
+        case OPT_LIST:
             list = 1;
-        else if (strcmp(argv[i], "--device") == 0 && i + 1 < argc)
-            device = (unsigned)strtoul(argv[++i], NULL, 10);
-        else if (argv[i][0] != '-' && !spec)
-            spec = argv[i];
-        else {
-            fprintf(stderr, "pose-bridge hid-describe: unexpected argument '%s'\n", argv[i]);
-            usage(stderr);
+            break;
+        case OPT_DEVICE:
+            if (pose_cli_long(&cli, 0, 65535, &n) < 0)
+                return 2;
+            device = (unsigned)n;
+            break;
+        case POSE_CLI_ARGUMENT:
+            if (spec) {
+                pose_cli_error(&cli, "unexpected argument '%s' (one device or file only)", cli.value);
+                return 2;
+            }
+            spec = cli.value;
+            break;
+        default: /* POSE_CLI_ERROR: reported */
             return 2;
         }
-    }
     if (list)
         return list_devices(json);
     if (!spec) {
-        usage(stderr);
+        pose_cli_error(&cli, "no device or hid-recorder file given");
         return 2;
     }
     pb_cli_warnings_begin(&warnings);

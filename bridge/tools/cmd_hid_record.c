@@ -8,6 +8,7 @@
 
 #include "hid_open.h"
 #include "pose_bridge_cli.h"
+#include "pose_cli.h"
 
 static volatile sig_atomic_t stop;
 
@@ -34,35 +35,52 @@ static void on_status(pb_source *src, pb_source_state state, const char *message
 
 static int run(int argc, char **argv)
 {
-    if (pb_cli_wants_help(argc, argv)) {
-        usage(stdout);
-        return 0;
-    }
+    enum { OPT_SECONDS = POSE_CLI_LONG_ONLY, OPT_COUNT, OPT_FAST, OPT_JSON };
+    static const struct option options[] = {
+        {"output", required_argument, NULL, 'o'}, {"seconds", required_argument, NULL, OPT_SECONDS},
+        {"count", required_argument, NULL, OPT_COUNT}, {"fast", no_argument, NULL, OPT_FAST},
+        {"json", no_argument, NULL, OPT_JSON},   {"help", no_argument, NULL, 'h'},
+        {0}};
     const char *spec = NULL, *out_path = NULL;
     double seconds = 0;
     long count = 0;
     int fast = 0, json = 0;
-    for (int i = 1; i < argc; i++) {
-        if ((strcmp(argv[i], "-o") == 0 || strcmp(argv[i], "--output") == 0) && i + 1 < argc)
-            out_path = argv[++i];
-        else if (strcmp(argv[i], "--seconds") == 0 && i + 1 < argc)
-            seconds = strtod(argv[++i], NULL);
-        else if (strcmp(argv[i], "--count") == 0 && i + 1 < argc)
-            count = strtol(argv[++i], NULL, 10);
-        else if (strcmp(argv[i], "--fast") == 0)
+    pose_cli cli;
+    pose_cli_begin(&cli, "pose-bridge hid-record", argc, argv, options);
+    for (int c; (c = pose_cli_next(&cli)) != POSE_CLI_END;)
+        switch (c) {
+        case 'h':
+            usage(stdout);
+            return 0;
+        case 'o':
+            out_path = cli.value;
+            break;
+        case OPT_SECONDS:
+            if (pose_cli_double(&cli, 0, 1e9, &seconds) < 0)
+                return 2;
+            break;
+        case OPT_COUNT:
+            if (pose_cli_long(&cli, 0, 1000000000, &count) < 0)
+                return 2;
+            break;
+        case OPT_FAST:
             fast = 1;
-        else if (strcmp(argv[i], "--json") == 0)
+            break;
+        case OPT_JSON:
             json = 1;
-        else if (argv[i][0] != '-' && !spec)
-            spec = argv[i];
-        else {
-            fprintf(stderr, "pose-bridge hid-record: unexpected argument '%s'\n", argv[i]);
-            usage(stderr);
+            break;
+        case POSE_CLI_ARGUMENT:
+            if (spec) {
+                pose_cli_error(&cli, "unexpected argument '%s' (one device only)", cli.value);
+                return 2;
+            }
+            spec = cli.value;
+            break;
+        default: /* POSE_CLI_ERROR: reported */
             return 2;
         }
-    }
     if (!spec || !out_path) {
-        usage(stderr);
+        pose_cli_error(&cli, "a device and -o FILE are required");
         return 2;
     }
     pb_hid_replay_options opt = {.as_fast_as_possible = fast};

@@ -9,7 +9,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli_maps.h"
 #include "cli_rig.h"
+#include "pose_cli.h"
 #include "pose/bridge.h"
 #include "pose_bridge_cli.h"
 
@@ -51,28 +53,51 @@ static int parse_times(const char *s, pose_args *a)
     return a->ntimes > 0 ? 0 : -1;
 }
 
+/* 0, 1 after --help, or 2 (reported). */
 static int parse(int argc, char **argv, pose_args *a)
 {
+    enum { OPT_RIG = POSE_CLI_LONG_ONLY, OPT_MAP, OPT_SKELETON, OPT_TIMES, OPT_JSON };
+    static const struct option options[] = {
+        {"rig", required_argument, NULL, OPT_RIG},   {"map", required_argument, NULL, OPT_MAP},
+        {"skeleton", required_argument, NULL, OPT_SKELETON}, {"times", required_argument, NULL, OPT_TIMES},
+        {"json", no_argument, NULL, OPT_JSON},       {"help", no_argument, NULL, 'h'},
+        {0}};
     memset(a, 0, sizeof *a);
-    for (int i = 1; i < argc; i++) {
-        const char *s = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (strcmp(s, "--rig") == 0 && v)
-            a->rig = argv[++i];
-        else if (strcmp(s, "--map") == 0 && v)
-            a->map = argv[++i];
-        else if (strcmp(s, "--skeleton") == 0 && v)
-            a->skeleton = argv[++i];
-        else if (strcmp(s, "--times") == 0 && v) {
-            if (parse_times(argv[++i], a) != 0)
-                return -1;
-        } else if (strcmp(s, "--json") == 0)
+    pose_cli cli;
+    pose_cli_begin(&cli, "pose-bridge pose", argc, argv, options);
+    for (int c; (c = pose_cli_next(&cli)) != POSE_CLI_END;)
+        switch (c) {
+        case 'h':
+            help(stdout);
+            return 1;
+        case OPT_RIG:
+            a->rig = cli.value;
+            break;
+        case OPT_MAP:
+            a->map = cli.value;
+            break;
+        case OPT_SKELETON:
+            a->skeleton = cli.value;
+            break;
+        case OPT_TIMES:
+            if (parse_times(cli.value, a) != 0)
+                return pose_cli_error(&cli, "--times: expected up to %d seconds as 0.5,2,7.25, got '%s'", MAX_TIMES,
+                                      cli.value), 2;
+            break;
+        case OPT_JSON:
             a->json = 1;
-        else if (s[0] != '-' && !a->source)
-            a->source = s;
-        else
-            return -1;
-    }
-    return a->source && a->rig && a->ntimes > 0 ? 0 : -1;
+            break;
+        case POSE_CLI_ARGUMENT:
+            if (a->source)
+                return pose_cli_error(&cli, "unexpected argument '%s' (one source only)", cli.value), 2;
+            a->source = cli.value;
+            break;
+        default: /* POSE_CLI_ERROR: reported */
+            return 2;
+        }
+    if (!a->source || !a->rig || a->ntimes == 0)
+        return pose_cli_error(&cli, "SOURCE, --rig and --times are required"), 2;
+    return 0;
 }
 
 static void print_time(const pose_args *a, const pose_rig *rig, const pose_state *st, double t,
@@ -104,16 +129,10 @@ static void print_time(const pose_args *a, const pose_rig *rig, const pose_state
 
 static int run(int argc, char **argv)
 {
-    if (pb_cli_wants_help(argc, argv)) {
-        help(stdout);
-        return 0;
-    }
     pose_args a;
-    if (parse(argc, argv, &a) != 0) {
-        fprintf(stderr, "pose-bridge pose: bad or missing arguments\n");
-        help(stderr);
-        return 2;
-    }
+    int parsed = parse(argc, argv, &a);
+    if (parsed != 0)
+        return parsed == 1 ? 0 : 2;
     char err[512];
     pose_rig *rig = NULL;
     pose_state *st = NULL;
@@ -124,8 +143,14 @@ static int run(int argc, char **argv)
         return 1;
     }
     pose_bridge_options o = {.size = sizeof o, .map_path = a.map, .skeleton = a.skeleton, .play = POSE_BRIDGE_MANUAL};
-    if (pose_state_create(rig, &st) < 0 || pose_bridge_open(a.source, rig, &o, &br) < 0) {
+    if (pose_state_create(rig, &st) < 0) {
         fprintf(stderr, "pose-bridge pose: %s\n", pose_last_error());
+        goto done;
+    }
+    if (pose_bridge_open(a.source, rig, &o, &br) < 0) {
+        fprintf(stderr, "pose-bridge pose: %s\n", pose_last_error());
+        if (!a.map)
+            pb_cli_hint_maps(a.source);
         goto done;
     }
     for (size_t i = 0; i < pose_bridge_warning_count(br); i++)

@@ -10,7 +10,9 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "cli_maps.h"
 #include "cli_rig.h"
+#include "pose_cli.h"
 #include "pose/bridge.h"
 #include "pose_bridge_cli.h"
 
@@ -47,68 +49,92 @@ typedef struct replay_args {
     int afap, loop, json, quiet;
 } replay_args;
 
+/* 0, 1 after --help, or 2 (reported). */
 static int parse(int argc, char **argv, replay_args *a)
 {
+    enum { OPT_SKELETON = POSE_CLI_LONG_ONLY, OPT_RIG, OPT_MAP, OPT_OUT, OPT_SPEED, OPT_RATE, OPT_HOST_RATE,
+           OPT_DURATION, OPT_START, OPT_FRAMES, OPT_RT_PRIORITY, OPT_AFAP, OPT_LOOP, OPT_JSON, OPT_QUIET };
+    static const struct option options[] = {
+        {"skeleton", required_argument, NULL, OPT_SKELETON}, {"rig", required_argument, NULL, OPT_RIG},
+        {"map", required_argument, NULL, OPT_MAP},           {"out", required_argument, NULL, OPT_OUT},
+        {"speed", required_argument, NULL, OPT_SPEED},       {"rate", required_argument, NULL, OPT_RATE},
+        {"host-rate", required_argument, NULL, OPT_HOST_RATE}, {"duration", required_argument, NULL, OPT_DURATION},
+        {"start", required_argument, NULL, OPT_START},       {"frames", required_argument, NULL, OPT_FRAMES},
+        {"rt-priority", required_argument, NULL, OPT_RT_PRIORITY}, {"afap", no_argument, NULL, OPT_AFAP},
+        {"loop", no_argument, NULL, OPT_LOOP},               {"json", no_argument, NULL, OPT_JSON},
+        {"quiet", no_argument, NULL, OPT_QUIET},             {"help", no_argument, NULL, 'h'},
+        {0}};
     memset(a, 0, sizeof *a);
     a->speed = 1.0;
     a->host_rate = 60.0;
-    for (int i = 1; i < argc; i++) {
-        const char *s = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        char *e = NULL;
-#define NUM(field)                                                             \
-    do {                                                                       \
-        if (!v)                                                                \
-            return -1;                                                         \
-        a->field = strtod(v, &e);                                              \
-        if (*e || !isfinite((double)a->field) || a->field < 0)                 \
-            return -1;                                                         \
-        i++;                                                                   \
-    } while (0)
-        if (strcmp(s, "--skeleton") == 0 && v)
-            a->skeleton = argv[++i];
-        else if (strcmp(s, "--rig") == 0 && v)
-            a->rig = argv[++i];
-        else if (strcmp(s, "--map") == 0 && v)
-            a->map = argv[++i];
-        else if (strcmp(s, "--out") == 0 && v)
-            a->out = argv[++i];
-        else if (strcmp(s, "--speed") == 0)
-            NUM(speed);
-        else if (strcmp(s, "--rate") == 0)
-            NUM(rate);
-        else if (strcmp(s, "--host-rate") == 0)
-            NUM(host_rate);
-        else if (strcmp(s, "--duration") == 0)
-            NUM(duration);
-        else if (strcmp(s, "--start") == 0)
-            NUM(start);
-        else if (strcmp(s, "--frames") == 0 && v) {
-            a->frames = strtol(v, &e, 10);
-            if (*e || a->frames < 0)
-                return -1;
-            i++;
-        } else if (strcmp(s, "--rt-priority") == 0 && v) {
-            a->rt_priority = strtol(v, &e, 10);
-            if (*e || a->rt_priority < 1 || a->rt_priority > 99)
-                return -1;
-            i++;
-        } else if (strcmp(s, "--afap") == 0)
+    pose_cli cli;
+    pose_cli_begin(&cli, "pose-bridge replay", argc, argv, options);
+    for (int c; (c = pose_cli_next(&cli)) != POSE_CLI_END;) {
+        int bad = 0;
+        switch (c) {
+        case 'h':
+            help(stdout);
+            return 1;
+        case OPT_SKELETON:
+            a->skeleton = cli.value;
+            break;
+        case OPT_RIG:
+            a->rig = cli.value;
+            break;
+        case OPT_MAP:
+            a->map = cli.value;
+            break;
+        case OPT_OUT:
+            a->out = cli.value;
+            break;
+        case OPT_SPEED:
+            bad = pose_cli_double(&cli, 1e-6, 1e6, &a->speed);
+            break;
+        case OPT_RATE:
+            bad = pose_cli_double(&cli, 0, 1e6, &a->rate);
+            break;
+        case OPT_HOST_RATE:
+            bad = pose_cli_double(&cli, 1e-3, 1e6, &a->host_rate);
+            break;
+        case OPT_DURATION:
+            bad = pose_cli_double(&cli, 0, 1e9, &a->duration);
+            break;
+        case OPT_START:
+            bad = pose_cli_double(&cli, 0, 1e9, &a->start);
+            break;
+        case OPT_FRAMES:
+            bad = pose_cli_long(&cli, 0, 1000000000, &a->frames);
+            break;
+        case OPT_RT_PRIORITY:
+            bad = pose_cli_long(&cli, 1, 99, &a->rt_priority);
+            break;
+        case OPT_AFAP:
             a->afap = 1;
-        else if (strcmp(s, "--loop") == 0)
+            break;
+        case OPT_LOOP:
             a->loop = 1;
-        else if (strcmp(s, "--json") == 0)
+            break;
+        case OPT_JSON:
             a->json = 1;
-        else if (strcmp(s, "--quiet") == 0)
+            break;
+        case OPT_QUIET:
             a->quiet = 1;
-        else if (s[0] != '-' && !a->source)
-            a->source = s;
-        else
-            return -1;
-#undef NUM
+            break;
+        case POSE_CLI_ARGUMENT:
+            if (a->source)
+                bad = pose_cli_error(&cli, "unexpected argument '%s' (one source only)", cli.value);
+            a->source = cli.value;
+            break;
+        default: /* POSE_CLI_ERROR: reported */
+            return 2;
+        }
+        if (bad)
+            return 2;
     }
-    if (!a->source || !a->rig || !(a->speed > 0) || !(a->host_rate > 0))
-        return -1;
+    if (!a->source || !a->rig) {
+        pose_cli_error(&cli, "SOURCE and --rig are required");
+        return 2;
+    }
     return 0;
 }
 
@@ -166,16 +192,10 @@ static void print_json(const replay_args *a, const pose_rig *rig, const pose_bri
 
 static int run(int argc, char **argv)
 {
-    if (pb_cli_wants_help(argc, argv)) {
-        help(stdout);
-        return 0;
-    }
     replay_args a;
-    if (parse(argc, argv, &a) != 0) {
-        fprintf(stderr, "pose-bridge replay: bad or missing arguments\n");
-        help(stderr);
-        return 2;
-    }
+    int parsed = parse(argc, argv, &a);
+    if (parsed != 0)
+        return parsed == 1 ? 0 : 2;
     char err[512];
     pose_rig *rig = NULL;
     pose_state *st = NULL;
@@ -205,6 +225,8 @@ static int run(int argc, char **argv)
     };
     if (pose_bridge_open(a.source, rig, &o, &br) < 0) {
         fprintf(stderr, "pose-bridge replay: %s\n", pose_last_error());
+        if (!a.map)
+            pb_cli_hint_maps(a.source);
         goto done;
     }
     for (size_t i = 0; i < pose_bridge_warning_count(br); i++)

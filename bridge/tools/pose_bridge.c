@@ -7,20 +7,13 @@
  * tools/cmd_*.c and generates the table pb_commands[] from the file names,
  * so no central list needs editing. <name> must be a C identifier
  * (cmd_hid_describe.c -> pb_cmd_hid_describe, typed as "hid-describe").
- * Each subcommand parses its own options, answers --help, prints results on
- * stdout (JSON with --json) and errors on stderr, and returns 0 on success.
+ * Each subcommand parses its own options with the tools' shared parser
+ * (cli/pose_cli.h), answers --help, prints results on stdout (JSON with
+ * --json) and errors on stderr, and returns 0 on success.
  */
 #include <string.h>
 
 #include "pose_bridge_cli.h"
-
-int pb_cli_wants_help(int argc, char **argv)
-{
-    for (int i = 1; i < argc; i++)
-        if (strcmp(argv[i], "-h") == 0 || strcmp(argv[i], "--help") == 0)
-            return 1;
-    return 0;
-}
 
 void pb_cli_json_string(FILE *f, const char *s)
 {

@@ -1,6 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 #include "ex_scene.h"
 
+#include "ex_args.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -330,9 +332,24 @@ int ex_scene_set_pose_arg(ex_scene *sc, const char *arg, char *err, size_t err_s
         snprintf(err, err_size, "--pose '%s': %s", arg, pose_last_error());
         return -1;
     }
-    if (st == POSE_CLAMPED)
+    if (st == POSE_CLAMPED) {
         fprintf(stderr, "note: --pose %s clamped by the joint's limits: %s\n", arg, pose_last_error());
+        ex_clamp_log *log = &sc->clamped;
+        if (log->count < sizeof log->text / sizeof log->text[0])
+            snprintf(log->text[log->count++], sizeof log->text[0], "--pose %s: %s", arg, pose_last_error());
+    }
     return 0;
+}
+
+void ex_clamp_log_json(const ex_clamp_log *log, void *file)
+{
+    FILE *f = file;
+    fputs("\"clamped\": [", f);
+    for (size_t i = 0; i < log->count; i++) {
+        fputs(i ? ", " : "", f);
+        ex_json_string(f, log->text[i]);
+    }
+    fputc(']', f);
 }
 
 void ex_weight_color(float w, float rgb[3])

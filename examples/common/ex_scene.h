@@ -21,6 +21,13 @@ typedef enum ex_skin_mode {
     EX_SKIN_HIDDEN,
 } ex_skin_mode;
 
+/* Requests the joint limits changed, for --json (the notes on stderr say the
+ * same): "--pose JOINT=...: what the limits did"; the first 16 are kept. */
+typedef struct ex_clamp_log {
+    char text[16][256];
+    size_t count;
+} ex_clamp_log;
+
 typedef struct ex_scene {
     pose_rig *rig;
     pose_state *state;
@@ -34,6 +41,7 @@ typedef struct ex_scene {
     float *boundary_normals;        /* 3 * tet vertex count, recomputed each frame */
     float *vertex_weight;           /* per tet vertex: weight of weight_joint */
     double last_apply_ms;           /* duration of the last ex_scene_apply */
+    ex_clamp_log clamped;           /* what the joint limits changed in the --pose requests */
 } ex_scene;
 
 /** Load a rig and create a state. Returns 0, or -1 with a message in err. */
@@ -70,10 +78,13 @@ const char *ex_method_name(pose_method m);
 
 /**
  * Apply "joint=rx,ry,rz" (degrees, XYZ order) to the state. Returns 0 (also
- * when the joint limits clamped it: a note goes to stderr) or -1 with a
- * message in err.
+ * when the joint limits clamped it: a note goes to stderr and into
+ * sc->clamped) or -1 with a message in err.
  */
 int ex_scene_set_pose_arg(ex_scene *sc, const char *arg, char *err, size_t err_size);
+
+/** Write `"clamped": [...]` (key included): each clamped request and what the limits did. */
+void ex_clamp_log_json(const ex_clamp_log *log, void *file);
 
 /** Blue-to-red ramp for a weight in [0,1]. */
 void ex_weight_color(float w, float rgb[3]);

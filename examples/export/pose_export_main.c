@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 
 #include "ex_args.h"
+#include "pose_cli.h"
 #include "ex_export.h"
 #include "ex_motion.h"
 #include "ex_scene.h"
@@ -39,55 +40,68 @@ int main(int argc, char **argv)
     int npose = 0, json = 0, method = -1;
     long frame = -1;
     char err[1024] = "";
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+    enum { OPT_POSE = POSE_CLI_LONG_ONLY, OPT_SOURCE, OPT_FRAME, OPT_MAP, OPT_METHOD, OPT_OBJ, OPT_PLY,
+           OPT_VTU, OPT_WEIGHTS, OPT_JSON };
+    static const struct option options[] = {
+        {"pose", required_argument, NULL, OPT_POSE},       {"source", required_argument, NULL, OPT_SOURCE},
+        {"frame", required_argument, NULL, OPT_FRAME},     {"map", required_argument, NULL, OPT_MAP},
+        {"method", required_argument, NULL, OPT_METHOD},   {"obj", required_argument, NULL, OPT_OBJ},
+        {"ply", required_argument, NULL, OPT_PLY},         {"vtu", required_argument, NULL, OPT_VTU},
+        {"weights", required_argument, NULL, OPT_WEIGHTS}, {"json", no_argument, NULL, OPT_JSON},
+        {"help", no_argument, NULL, 'h'},                  {0}};
+    pose_cli cli;
+    pose_cli_begin(&cli, "pose-export", argc, argv, options);
+    for (int c; (c = pose_cli_next(&cli)) != POSE_CLI_END;) {
+        switch (c) {
+        case 'h':
             usage(stdout);
             return 0;
-        }
-        if (!strcmp(a, "--json")) {
+        case OPT_JSON:
             json = 1;
-            continue;
-        }
-        if (a[0] != '-') {
+            break;
+        case POSE_CLI_ARGUMENT:
             if (rig) {
-                fprintf(stderr, "pose-export: unexpected argument '%s' (one rig only)\n", a);
+                pose_cli_error(&cli, "unexpected argument '%s' (one rig only)", cli.value);
                 return 2;
             }
-            rig = a;
-            continue;
-        }
-        if (!v) {
-            fprintf(stderr, "pose-export: %s needs a value (see --help)\n", a);
-            return 2;
-        }
-        i++;
-        if (!strcmp(a, "--obj"))
-            obj = v;
-        else if (!strcmp(a, "--ply"))
-            ply = v;
-        else if (!strcmp(a, "--vtu"))
-            vtu = v;
-        else if (!strcmp(a, "--source"))
-            source = v;
-        else if (!strcmp(a, "--map"))
-            map = v;
-        else if (!strcmp(a, "--weights"))
-            weights = v;
-        else if (!strcmp(a, "--pose") && npose < MAX_POSES)
-            poses[npose++] = v;
-        else if (!strcmp(a, "--frame")) {
-            if (ex_parse_long(a, v, 0, 100000000, &frame, err, sizeof err) < 0) {
-                fprintf(stderr, "pose-export: %s\n", err);
+            rig = cli.value;
+            break;
+        case OPT_OBJ:
+            obj = cli.value;
+            break;
+        case OPT_PLY:
+            ply = cli.value;
+            break;
+        case OPT_VTU:
+            vtu = cli.value;
+            break;
+        case OPT_SOURCE:
+            source = cli.value;
+            break;
+        case OPT_MAP:
+            map = cli.value;
+            break;
+        case OPT_WEIGHTS:
+            weights = cli.value;
+            break;
+        case OPT_POSE:
+            if (npose == MAX_POSES) {
+                pose_cli_error(&cli, "at most %d --pose options", MAX_POSES);
                 return 2;
             }
-        } else if (!strcmp(a, "--method")) {
-            if ((method = ex_parse_method(v)) < 0) {
-                fprintf(stderr, "pose-export: --method: expected lbs, dqs or cor, got '%s'\n", v);
+            poses[npose++] = cli.value;
+            break;
+        case OPT_FRAME:
+            if (pose_cli_long(&cli, 0, 100000000, &frame) < 0)
+                return 2;
+            break;
+        case OPT_METHOD:
+            if ((method = ex_parse_method(cli.value)) < 0) {
+                pose_cli_error(&cli, "--method: expected lbs, dqs or cor, got '%s'", cli.value);
                 return 2;
             }
-        } else {
-            fprintf(stderr, "pose-export: unknown option '%s' (see --help)\n", a);
+            break;
+        default: /* POSE_CLI_ERROR: reported */
             return 2;
         }
     }
@@ -144,6 +158,8 @@ int main(int argc, char **argv)
         ex_json_string(stdout, rig);
         printf(", \"method\": \"%s\", \"tissues\": %zu, \"apply_ms\": %.3f", ex_method_name(m), sc.tissue_count,
                sc.last_apply_ms);
+        printf(", ");
+        ex_clamp_log_json(&sc.clamped, stdout);
         const char *keys[3] = {"obj", "ply", "vtu"}, *vals[3] = {obj, ply, vtu};
         for (int k = 0; k < 3; k++)
             if (vals[k]) {

@@ -7,6 +7,7 @@
 #include "ex_args.h"
 #include "ex_font.h"
 #include "ex_motion.h"
+#include "pose_cli.h"
 
 void ex_render_usage(FILE *f)
 {
@@ -100,69 +101,95 @@ int ex_render_parse(int argc, char **argv, ex_render_options *o, char *err, size
     o->supersample = 2;
     o->method = -1;
     o->zoom = 1.0;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+    enum { OPT_JSON = POSE_CLI_LONG_ONLY, OPT_LIST_JOINTS, OPT_COMPARE, OPT_SOURCE, OPT_MAP, OPT_CAPTION,
+           OPT_WEIGHTS, OPT_FOCUS, OPT_POSE, OPT_FRAMES, OPT_TIMES, OPT_TURNTABLE, OPT_METHOD, OPT_SKIN, OPT_FIT,
+           OPT_HIDE, OPT_SIZE, OPT_SUPERSAMPLE, OPT_THREADS, OPT_AZIMUTH, OPT_ELEVATION, OPT_ZOOM };
+    static const struct option options[] = {
+        {"output", required_argument, NULL, 'o'},           {"json", no_argument, NULL, OPT_JSON},
+        {"list-joints", no_argument, NULL, OPT_LIST_JOINTS}, {"compare", no_argument, NULL, OPT_COMPARE},
+        {"source", required_argument, NULL, OPT_SOURCE},     {"map", required_argument, NULL, OPT_MAP},
+        {"caption", required_argument, NULL, OPT_CAPTION},   {"weights", required_argument, NULL, OPT_WEIGHTS},
+        {"focus", required_argument, NULL, OPT_FOCUS},       {"pose", required_argument, NULL, OPT_POSE},
+        {"frames", required_argument, NULL, OPT_FRAMES},     {"times", required_argument, NULL, OPT_TIMES},
+        {"turntable", required_argument, NULL, OPT_TURNTABLE}, {"method", required_argument, NULL, OPT_METHOD},
+        {"skin", required_argument, NULL, OPT_SKIN},         {"fit", required_argument, NULL, OPT_FIT},
+        {"hide", required_argument, NULL, OPT_HIDE},         {"size", required_argument, NULL, OPT_SIZE},
+        {"supersample", required_argument, NULL, OPT_SUPERSAMPLE},
+        {"threads", required_argument, NULL, OPT_THREADS},   {"azimuth", required_argument, NULL, OPT_AZIMUTH},
+        {"elevation", required_argument, NULL, OPT_ELEVATION}, {"zoom", required_argument, NULL, OPT_ZOOM},
+        {"help", no_argument, NULL, 'h'},                    {0}};
+    pose_cli cli;
+    pose_cli_begin(&cli, "pose-render", argc, argv, options);
+    for (int c; (c = pose_cli_next(&cli)) != POSE_CLI_END;) {
+        const char *a = cli.name, *v = cli.value;
         long l;
-        int takes = 1;
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+        switch (c) {
+        case 'h':
             ex_render_usage(stdout);
             return 1;
-        } else if (!strcmp(a, "--json")) {
+        case OPT_JSON:
             o->json = 1;
-            takes = 0;
-        } else if (!strcmp(a, "--list-joints")) {
+            break;
+        case OPT_LIST_JOINTS:
             o->list_joints = 1;
-            takes = 0;
-        } else if (!strcmp(a, "--compare")) {
+            break;
+        case OPT_COMPARE:
             o->compare = 1;
-            takes = 0;
-        } else if (a[0] != '-') {
+            break;
+        case POSE_CLI_ARGUMENT:
             if (o->rig) {
-                snprintf(err, err_size, "unexpected argument '%s' (one rig only)", a);
+                snprintf(err, err_size, "unexpected argument '%s' (one rig only)", v);
                 return -1;
             }
-            o->rig = a;
-            takes = 0;
-        } else if (!v) {
-            snprintf(err, err_size, "%s needs a value (see --help)", a);
-            return -1;
-        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+            o->rig = v;
+            break;
+        case 'o':
             o->output = v;
-        } else if (!strcmp(a, "--source")) {
+            break;
+        case OPT_SOURCE:
             o->source = v;
-        } else if (!strcmp(a, "--map")) {
+            break;
+        case OPT_MAP:
             o->map = v;
-        } else if (!strcmp(a, "--caption")) {
+            break;
+        case OPT_CAPTION:
             o->caption = v;
-        } else if (!strcmp(a, "--weights")) {
+            break;
+        case OPT_WEIGHTS:
             o->weights = v;
-        } else if (!strcmp(a, "--focus")) {
+            break;
+        case OPT_FOCUS:
             o->focus = v;
-        } else if (!strcmp(a, "--pose")) {
+            break;
+        case OPT_POSE:
             if (o->pose_count == EX_RENDER_MAX_POSES) {
                 snprintf(err, err_size, "--pose: at most %d joints", EX_RENDER_MAX_POSES);
                 return -1;
             }
             o->poses[o->pose_count++] = v;
-        } else if (!strcmp(a, "--frames")) {
+            break;
+        case OPT_FRAMES:
             free(o->frames);
             if (ex_parse_frames(a, v, &o->frames, &o->frame_count, err, err_size) < 0)
                 return -1;
-        } else if (!strcmp(a, "--times")) {
+            break;
+        case OPT_TIMES:
             free(o->times);
             if (ex_parse_times(a, v, &o->times, &o->time_count, err, err_size) < 0)
                 return -1;
-        } else if (!strcmp(a, "--turntable")) {
+            break;
+        case OPT_TURNTABLE:
             if (ex_parse_long(a, v, 1, 3600, &l, err, err_size) < 0)
                 return -1;
             o->turntable = (int)l;
-        } else if (!strcmp(a, "--method")) {
+            break;
+        case OPT_METHOD:
             if ((o->method = ex_parse_method(v)) < 0) {
                 snprintf(err, err_size, "--method: expected lbs, dqs or cor, got '%s'", v);
                 return -1;
             }
-        } else if (!strcmp(a, "--skin")) {
+            break;
+        case OPT_SKIN: {
             static const char *modes[] = {"auto", "translucent", "opaque", "hidden"};
             int m = -1;
             for (int k = 0; k < 4; k++)
@@ -173,43 +200,51 @@ int ex_render_parse(int argc, char **argv, ex_render_options *o, char *err, size
                 return -1;
             }
             o->skin = (ex_skin_mode)m;
-        } else if (!strcmp(a, "--fit")) {
+            break;
+        }
+        case OPT_FIT:
             if (strcmp(v, "pose") && strcmp(v, "rest") && strcmp(v, "follow")) {
                 snprintf(err, err_size, "--fit: expected pose, rest or follow, got '%s'", v);
                 return -1;
             }
             o->fit_rest = !strcmp(v, "rest");
             o->follow = !strcmp(v, "follow");
-        } else if (!strcmp(a, "--hide")) {
+            break;
+        case OPT_HIDE:
             if (parse_kinds(v, &o->hide, err, err_size) < 0)
                 return -1;
-        } else if (!strcmp(a, "--size")) {
+            break;
+        case OPT_SIZE:
             if (ex_parse_size(a, v, &o->width, &o->height, err, err_size) < 0)
                 return -1;
-        } else if (!strcmp(a, "--supersample")) {
+            break;
+        case OPT_SUPERSAMPLE:
             if (ex_parse_long(a, v, 1, 4, &l, err, err_size) < 0)
                 return -1;
             o->supersample = (int)l;
-        } else if (!strcmp(a, "--threads")) {
+            break;
+        case OPT_THREADS:
             if (ex_parse_long(a, v, 0, 256, &l, err, err_size) < 0)
                 return -1;
             o->threads = (int)l;
-        } else if (!strcmp(a, "--azimuth")) {
+            break;
+        case OPT_AZIMUTH:
             if (ex_parse_double(a, v, -3600, 3600, &o->azimuth, err, err_size) < 0)
                 return -1;
             o->have_azimuth = 1;
-        } else if (!strcmp(a, "--elevation")) {
+            break;
+        case OPT_ELEVATION:
             if (ex_parse_double(a, v, -89, 89, &o->elevation, err, err_size) < 0)
                 return -1;
             o->have_elevation = 1;
-        } else if (!strcmp(a, "--zoom")) {
+            break;
+        case OPT_ZOOM:
             if (ex_parse_double(a, v, 0.05, 50, &o->zoom, err, err_size) < 0)
                 return -1;
-        } else {
-            snprintf(err, err_size, "unknown option '%s' (see --help)", a);
+            break;
+        default: /* POSE_CLI_ERROR: reported on stderr, err stays empty */
             return -1;
         }
-        i += takes;
     }
     if (!o->rig) {
         snprintf(err, err_size, "no rig given (usage: pose-render RIG [options]; see --help)");

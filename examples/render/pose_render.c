@@ -90,6 +90,7 @@ static void caption(ex_image *img, const char *text)
 
 typedef struct summary {
     FILE *json;
+    ex_clamp_log clamped; /* the scene's, kept for the summary after the scene is closed */
     int first;
     double apply_ms, render_ms;
     int images;
@@ -449,6 +450,7 @@ static int run(const ex_render_options *o, summary *s, char *err, size_t err_siz
     else
         rc = render_turntable(&jb, o->turntable ? o->turntable : 1, folder);
 done:
+    s->clamped = jb.sc.clamped;
     ex_image_free(&jb.img);
     renderer_free(&jb.r);
     ex_motion_close(jb.motion);
@@ -462,7 +464,7 @@ int main(int argc, char **argv)
     char err[1024] = "";
     int parsed = ex_render_parse(argc, argv, &o, err, sizeof err);
     if (parsed != 0) {
-        if (parsed < 0)
+        if (parsed < 0 && err[0]) /* else the option parser has said what was wrong */
             fprintf(stderr, "pose-render: %s\n", err);
         free(o.frames);
         free(o.times);
@@ -478,7 +480,8 @@ int main(int argc, char **argv)
     if (s.json && isatty(STDERR_FILENO) && s.total > 1 && s.images)
         fputc('\n', stderr);
     if (s.json) {
-        fprintf(s.json, "\n  ],\n  \"ok\": %s", rc == 0 ? "true" : "false");
+        fprintf(s.json, "\n  ],\n  \"ok\": %s,\n  ", rc == 0 ? "true" : "false");
+        ex_clamp_log_json(&s.clamped, s.json);
         if (s.images)
             fprintf(s.json, ",\n  \"mean_apply_ms\": %.3f, \"mean_image_ms\": %.1f", s.apply_ms / s.images,
                     s.render_ms / s.images);

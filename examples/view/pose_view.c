@@ -16,6 +16,7 @@
 #include "ex_draw.h"
 #include "ex_motion.h"
 #include "ex_scene.h"
+#include "pose_cli.h"
 
 typedef struct viewer {
     ex_scene sc;
@@ -41,6 +42,8 @@ static void usage(FILE *f)
           "  --pose JOINT=RX,RY,RZ   initial joint angles (degrees; repeatable)\n"
           "  --size WxH              window size (default 1280x800)\n"
           "  --quit-after N          close after N frames and print the frame rate (smoke tests)\n"
+          "  --json                  at exit, a JSON summary on stdout (frames, fps, method, source,\n"
+          "                          clamped --pose requests) instead of the line --quit-after prints\n"
           "  -h, --help              this text\n"
           "Mouse: drag orbit, right drag pan, wheel zoom, ctrl+click pick a joint, shift+drag rotate it\n"
           "Keys: 1 LBS 2 DQS 3 CoR | S skin\n"
@@ -291,45 +294,82 @@ static void hud(viewer *v, int fw, int fh)
     }
 }
 
+/* What the session did, for scripts: the --json summary printed when the window closes. */
+static void print_summary_json(viewer *v, const char *rig, long frames, double seconds, double apply_sum_ms)
+{
+    printf("{\"rig\": ");
+    ex_json_string(stdout, rig);
+    printf(", \"frames\": %ld, \"seconds\": %.3f, \"fps\": %.2f, \"apply_ms_mean\": %.4f, \"method\": \"%s\", ",
+           frames, seconds, seconds > 0 ? (double)frames / seconds : 0.0,
+           frames > 0 ? apply_sum_ms / (double)frames : 0.0, ex_method_name(pose_get_method(v->sc.state)));
+    ex_clamp_log_json(&v->sc.clamped, stdout);
+    if (v->motion) {
+        printf(", \"source\": ");
+        ex_json_string(stdout, ex_motion_status(v->motion));
+    }
+    printf("}\n");
+}
+
 int main(int argc, char **argv)
 {
     const char *rig = NULL, *source = NULL, *map = NULL, *poses[64];
-    int npose = 0, method = -1, width = 1280, height = 800;
+    int npose = 0, method = -1, width = 1280, height = 800, json = 0;
     long quit_after = 0;
     char err[1024] = "";
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+    enum { OPT_SOURCE = POSE_CLI_LONG_ONLY, OPT_MAP, OPT_POSE, OPT_METHOD, OPT_SIZE, OPT_QUIT_AFTER, OPT_JSON };
+    static const struct option options[] = {
+        {"source", required_argument, NULL, OPT_SOURCE}, {"map", required_argument, NULL, OPT_MAP},
+        {"pose", required_argument, NULL, OPT_POSE},     {"method", required_argument, NULL, OPT_METHOD},
+        {"size", required_argument, NULL, OPT_SIZE},     {"quit-after", required_argument, NULL, OPT_QUIT_AFTER},
+        {"json", no_argument, NULL, OPT_JSON},           {"help", no_argument, NULL, 'h'},
+        {0}};
+    pose_cli cli;
+    pose_cli_begin(&cli, "pose-view", argc, argv, options);
+    for (int c; (c = pose_cli_next(&cli)) != POSE_CLI_END;) {
+        switch (c) {
+        case 'h':
             usage(stdout);
             return 0;
-        }
-        if (a[0] != '-') {
+        case POSE_CLI_ARGUMENT:
             if (rig) {
-                fprintf(stderr, "pose-view: unexpected argument '%s' (one rig only)\n", a);
+                pose_cli_error(&cli, "unexpected argument '%s' (one rig only)", cli.value);
                 return 2;
             }
-            rig = a;
-            continue;
-        }
-        if (!val) {
-            fprintf(stderr, "pose-view: %s needs a value (see --help)\n", a);
-            return 2;
-        }
-        i++;
-        if (!strcmp(a, "--source"))
-            source = val;
-        else if (!strcmp(a, "--map"))
-            map = val;
-        else if (!strcmp(a, "--pose") && npose < 64)
-            poses[npose++] = val;
-        else if (!strcmp(a, "--method") && (method = ex_parse_method(val)) >= 0)
-            ;
-        else if (!strcmp(a, "--size") && ex_parse_size(a, val, &width, &height, err, sizeof err) == 0)
-            ;
-        else if (!strcmp(a, "--quit-after") && ex_parse_long(a, val, 1, 1000000, &quit_after, err, sizeof err) == 0)
-            ;
-        else {
-            fprintf(stderr, "pose-view: bad option '%s %s' (see --help)%s%s\n", a, val, err[0] ? ": " : "", err);
+            rig = cli.value;
+            break;
+        case OPT_SOURCE:
+            source = cli.value;
+            break;
+        case OPT_MAP:
+            map = cli.value;
+            break;
+        case OPT_POSE:
+            if (npose == 64) {
+                pose_cli_error(&cli, "at most 64 --pose options");
+                return 2;
+            }
+            poses[npose++] = cli.value;
+            break;
+        case OPT_METHOD:
+            if ((method = ex_parse_method(cli.value)) < 0) {
+                pose_cli_error(&cli, "--method: expected lbs, dqs or cor, got '%s'", cli.value);
+                return 2;
+            }
+            break;
+        case OPT_SIZE:
+            if (ex_parse_size(cli.name, cli.value, &width, &height, err, sizeof err) < 0) {
+                pose_cli_error(&cli, "%s", err);
+                return 2;
+            }
+            break;
+        case OPT_QUIT_AFTER:
+            if (pose_cli_long(&cli, 1, 1000000, &quit_after) < 0)
+                return 2;
+            break;
+        case OPT_JSON:
+            json = 1;
+            break;
+        default: /* POSE_CLI_ERROR: reported */
             return 2;
         }
     }
@@ -434,7 +474,9 @@ int main(int argc, char **argv)
             fps_t = now;
         }
     }
-    if (quit_after && total > 0)
+    if (json)
+        print_summary_json(&v, rig, total, glfwGetTime() - start, apply_sum);
+    else if (quit_after && total > 0)
         printf("pose-view: %ld frames in %.2f s (%.1f fps), mean pose_apply %.3f ms, method %s%s%s\n", total,
                glfwGetTime() - start, (double)total / (glfwGetTime() - start), apply_sum / (double)total,
                ex_method_name(pose_get_method(v.sc.state)), v.motion ? ", source " : "",

@@ -4,6 +4,7 @@
  * Exit status: 0 success, 1 the bake failed (message on stderr), 2 usage.
  */
 #include "bake_pipeline.h"
+#include "pose_cli.h"
 
 #include <dirent.h>
 #include <errno.h>
@@ -136,21 +137,6 @@ static int add_path(path_list *l, const char *path, const char *what)
     return 0;
 }
 
-static int parse_uint(const char *s, const char *opt, unsigned long lo, unsigned long hi,
-                      unsigned long *out)
-{
-    char *end;
-    errno = 0;
-    unsigned long v = s ? strtoul(s, &end, 10) : 0;
-    if (!s || errno || *end || end == s || v < lo || v > hi || s[0] == '-') {
-        fprintf(stderr, "pose-bake: %s needs an integer in %lu..%lu (got '%s')\n", opt, lo, hi,
-                s ? s : "");
-        return -1;
-    }
-    *out = v;
-    return 0;
-}
-
 typedef struct progress_state {
     int tty;
     double start;
@@ -236,90 +222,117 @@ int main(int argc, char **argv)
     const char *report_path = NULL;
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     o.threads = cores > 0 ? (int)cores : 1;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *next = i + 1 < argc ? argv[i + 1] : NULL;
-        unsigned long u;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+    enum { OPT_BONES = POSE_CLI_LONG_ONLY, OPT_ORGANS, OPT_SKIN, OPT_TEMPLATE, OPT_VTU, OPT_REPORT,
+           OPT_RESOLUTION, OPT_TARGET_VERTICES, OPT_BACKEND, OPT_THREADS, OPT_COR_STEP, OPT_NO_COR,
+           OPT_JSON, OPT_QUIET, OPT_VERSION };
+    static const struct option options[] = {
+        {"skin", required_argument, NULL, OPT_SKIN},
+        {"bones", required_argument, NULL, OPT_BONES},
+        {"organs", required_argument, NULL, OPT_ORGANS},
+        {"template", required_argument, NULL, OPT_TEMPLATE},
+        {"output", required_argument, NULL, 'o'},
+        {"resolution", required_argument, NULL, OPT_RESOLUTION},
+        {"target-vertices", required_argument, NULL, OPT_TARGET_VERTICES},
+        {"backend", required_argument, NULL, OPT_BACKEND},
+        {"influences", required_argument, NULL, 'K'},
+        {"threads", required_argument, NULL, OPT_THREADS},
+        {"cor-step", required_argument, NULL, OPT_COR_STEP},
+        {"no-cor", no_argument, NULL, OPT_NO_COR},
+        {"vtu", required_argument, NULL, OPT_VTU},
+        {"json", no_argument, NULL, OPT_JSON},
+        {"report", required_argument, NULL, OPT_REPORT},
+        {"quiet", no_argument, NULL, OPT_QUIET},
+        {"version", no_argument, NULL, OPT_VERSION},
+        {"help", no_argument, NULL, 'h'},
+        {0}};
+    pose_cli cli;
+    pose_cli_begin(&cli, "pose-bake", argc, argv, options);
+    /* --bones and --organs take every argument up to the next option (shell globs). */
+    path_list *list = NULL;
+    double d;
+    long n;
+    for (int c; (c = pose_cli_next(&cli)) != POSE_CLI_END;) {
+        if (c != POSE_CLI_ARGUMENT)
+            list = NULL;
+        switch (c) {
+        case 'h':
             usage(stdout);
             status = 0;
             goto out;
-        } else if (!strcmp(a, "--version")) {
+        case OPT_VERSION:
             printf("pose-bake %s\n", pose_version_string());
             status = 0;
             goto out;
-        } else if (!strcmp(a, "--bones") || !strcmp(a, "--organs")) {
-            path_list *l = a[2] == 'b' ? &bones : &organs;
-            if (!next || next[0] == '-') {
-                fprintf(stderr, "pose-bake: %s needs a directory or files\n", a);
+        case OPT_BONES:
+        case OPT_ORGANS:
+        case POSE_CLI_ARGUMENT: /* the option's value is its list's first path */
+            if (c != POSE_CLI_ARGUMENT)
+                list = c == OPT_BONES ? &bones : &organs;
+            if (!list) {
+                pose_cli_error(&cli, "unexpected argument '%s'", cli.value);
                 goto out;
             }
-            /* Every argument up to the next option: works with shell globs. */
-            while (i + 1 < argc && argv[i + 1][0] != '-')
-                if (add_path(l, argv[++i], a + 2) < 0) {
-                    status = 1;
-                    goto out;
-                }
-        } else if (!next && (!strcmp(a, "--skin") || !strcmp(a, "--template") || !strcmp(a, "-o") ||
-                             !strcmp(a, "--output") || !strcmp(a, "--resolution") ||
-                             !strcmp(a, "--target-vertices") || !strcmp(a, "--backend") ||
-                             !strcmp(a, "-K") || !strcmp(a, "--influences") ||
-                             !strcmp(a, "--threads") || !strcmp(a, "--vtu") ||
-                             !strcmp(a, "--cor-step") ||
-                             !strcmp(a, "--report"))) {
-            fprintf(stderr, "pose-bake: %s needs a value\n", a);
-            goto out;
-        } else if (!strcmp(a, "--skin")) {
-            o.skin_path = argv[++i];
-        } else if (!strcmp(a, "--template")) {
-            o.template_path = argv[++i];
-        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-            o.output_path = argv[++i];
-        } else if (!strcmp(a, "--vtu")) {
-            o.vtu_path = argv[++i];
-        } else if (!strcmp(a, "--report")) {
-            report_path = argv[++i];
-        } else if (!strcmp(a, "--resolution")) {
-            char *end;
-            o.resolution_mm = strtod(argv[++i], &end);
-            if (*end || !(o.resolution_mm >= 0.2 && o.resolution_mm <= 100)) {
-                fprintf(stderr, "pose-bake: --resolution needs millimetres in 0.2..100 (got '%s')\n",
-                        argv[i]);
+            if (add_path(list, cli.value, list == &bones ? "bones" : "organs") < 0) {
+                status = 1;
                 goto out;
             }
-        } else if (!strcmp(a, "--target-vertices")) {
-            if (parse_uint(argv[++i], a, 100, 100000000, &u) < 0)
+            break;
+        case OPT_SKIN:
+            o.skin_path = cli.value;
+            break;
+        case OPT_TEMPLATE:
+            o.template_path = cli.value;
+            break;
+        case 'o':
+            o.output_path = cli.value;
+            break;
+        case OPT_VTU:
+            o.vtu_path = cli.value;
+            break;
+        case OPT_REPORT:
+            report_path = cli.value;
+            break;
+        case OPT_RESOLUTION:
+            if (pose_cli_double(&cli, 0.2, 100, &d) < 0)
                 goto out;
-            o.target_vertices = u;
-        } else if (!strcmp(a, "--backend")) {
-            if (pp_tet_backend_parse(argv[++i], &o.backend) < 0) {
-                fprintf(stderr, "pose-bake: --backend is lattice or tetgen (got '%s')\n", argv[i]);
+            o.resolution_mm = d;
+            break;
+        case OPT_TARGET_VERTICES:
+            if (pose_cli_long(&cli, 100, 100000000, &n) < 0)
+                goto out;
+            o.target_vertices = (size_t)n;
+            break;
+        case OPT_BACKEND:
+            if (pp_tet_backend_parse(cli.value, &o.backend) < 0) {
+                pose_cli_error(&cli, "--backend is lattice or tetgen (got '%s')", cli.value);
                 goto out;
             }
-        } else if (!strcmp(a, "-K") || !strcmp(a, "--influences")) {
-            if (parse_uint(argv[++i], a, 1, PP_MAX_INFLUENCES, &u) < 0)
+            break;
+        case 'K':
+            if (pose_cli_long(&cli, 1, PP_MAX_INFLUENCES, &n) < 0)
                 goto out;
-            o.influences = (unsigned)u;
-        } else if (!strcmp(a, "--threads")) {
-            if (parse_uint(argv[++i], a, 1, 64, &u) < 0)
+            o.influences = (unsigned)n;
+            break;
+        case OPT_THREADS:
+            if (pose_cli_long(&cli, 1, 64, &n) < 0)
                 goto out;
-            o.threads = (int)u;
-        } else if (!strcmp(a, "--cor-step")) {
-            char *end;
-            o.cor_step = strtod(argv[++i], &end);
-            if (*end || !(o.cor_step >= 1e-5 && o.cor_step <= 0.5)) {
-                fprintf(stderr, "pose-bake: --cor-step needs a number in 1e-5..0.5 (got '%s')\n",
-                        argv[i]);
+            o.threads = (int)n;
+            break;
+        case OPT_COR_STEP:
+            if (pose_cli_double(&cli, 1e-5, 0.5, &d) < 0)
                 goto out;
-            }
-        } else if (!strcmp(a, "--no-cor")) {
+            o.cor_step = d;
+            break;
+        case OPT_NO_COR:
             o.no_cor = 1;
-        } else if (!strcmp(a, "--json")) {
+            break;
+        case OPT_JSON:
             json = 1;
-        } else if (!strcmp(a, "--quiet")) {
+            break;
+        case OPT_QUIET:
             quiet = 1;
-        } else {
-            fprintf(stderr, "pose-bake: unknown argument '%s' (see --help)\n", a);
+            break;
+        default: /* POSE_CLI_ERROR: reported */
             goto out;
         }
     }
