@@ -336,16 +336,14 @@ int pb_candump_next(pb_candump_reader *r, pb_can_frame *f)
             reject(r, "line too long (over " PB_STR(PB_CANDUMP_LINE_MAX) " bytes)", cut);
         else if (nul)
             reject(r, "NUL byte in the line", cut);
-        else if (!terminated)
-            reject(r, "skipped", cut);
         else {
-            int rc = pb_candump_parse_line(buf, n, f, r->iface, sizeof r->iface, &why);
-            if (rc == 1) {
+            const int rc = pb_candump_parse_line(buf, n, f, r->iface, sizeof r->iface, &why);
+            if (rc == 1 && terminated) {
                 r->frames++;
                 return 1;
             }
-            if (rc < 0)
-                reject(r, why, cut);
+            if (rc != 0) /* not a blank or comment line */
+                reject(r, rc == 1 ? "skipped" : why, cut);
         }
     }
     return ferror(r->file) ? -1 : 0;
