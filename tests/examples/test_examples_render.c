@@ -195,6 +195,18 @@ static void test_view_under_xvfb(void **state)
     printf("%s", out);
     assert_non_null(strstr(out, "pose-view: 5 frames in"));
     assert_non_null(strstr(out, "method CoR"));
+    /* --json: the session as one JSON object, with what the joint limits clamped. */
+    assert_int_equal(run(log, "ASAN_OPTIONS=\"${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0\" "
+                              "xvfb-run -a -s '-screen 0 640x480x24' '%s' '%s' --size 320x240 --quit-after 3 "
+                              "--json --pose joint2=0,170,0",
+                         view_bin, bar),
+                     0);
+    out = slurp(log);
+    printf("%s", out);
+    assert_non_null(strstr(out, "{\"rig\": "));
+    assert_non_null(strstr(out, "\"frames\": 3, "));
+    assert_non_null(strstr(out, "\"method\": \"CoR\""));
+    assert_non_null(strstr(out, "\"clamped\": [\"--pose joint2=0,170,0: joint 2 'joint2': y 170.00 clamped to 150.00"));
 }
 
 /* The viewer driven live by recorded devices through the bridge's thread: poses arrive. */
@@ -547,6 +559,14 @@ static void test_export(void **state)
     assert_int_equal(run(log, "'%s' '%s' --pose joint2=0,90,0 --obj '%s' --ply '%s' --vtu '%s' --weights joint2",
                          export_bin, bar, obj, ply, vtu),
                      0);
+    /* --json lists what the joint limits clamped (the bar's limits are 150 degrees), and only that. */
+    assert_int_equal(run(log, "'%s' '%s' --pose joint1=0,20,0 --pose joint2=0,170,0 --obj '%s/clamped.obj' --json",
+                         export_bin, bar, tmp),
+                     0);
+    const char *json = slurp(log);
+    printf("%s", json);
+    assert_non_null(strstr(json, "\"clamped\": [\"--pose joint2=0,170,0: joint 2 'joint2': y 170.00 clamped to "
+                                 "150.00 [-150.00, 150.00] degrees (limits in XYZ order)\"]"));
     /* OBJ: as many v lines as the rig has tissue vertices, faces index within range. */
     FILE *f = fopen(obj, "r");
     assert_non_null(f);
