@@ -133,8 +133,8 @@ static int run(int argc, char **argv)
     pb_can_bus *bus = NULL;
     static pb_warnings warnings;
     pb_cli_warnings_begin(&warnings);
+    /* Installed for the whole run: a log's bad lines and time jumps are found while it plays. */
     pose_status loaded = pb_can_bus_load(bus_path, &bus, &err);
-    pb_warnings_install(NULL);
     if (loaded != POSE_OK) {
         fprintf(stderr, "pose-bridge can-monitor: %s\n", err.message);
         return 1;
@@ -189,6 +189,7 @@ static int run(int argc, char **argv)
     report(src, dec, last, (prev - t0) * 1e-9, 0, json);
     free(last);
     pb_source_destroy(src);
+    pb_warnings_install(NULL);
     return status;
 }
 

@@ -30,6 +30,7 @@
 #include "can_source.h"
 #include "can_record.h"
 #include "candump_log.h"
+#include "pb_warn.h"
 
 static void send_classic(int fd, canid_t id, const uint8_t *data, uint8_t len)
 {
@@ -446,6 +447,51 @@ static void test_reopen_by_name(void **state)
     assert_int_equal(pb_can_socket_open("vcan-test", NULL, 0, &err), -1);
 }
 
+/* A candump log whose stamps jump an hour ahead, then back: replayed at
+ * recorded timing, it used to stall for the hour (can-monitor --log went
+ * silent) and take the step back without a word. The jumps are taken out,
+ * each a warning naming the line, and the replay goes on in order. */
+static void test_replay_time_jumps(void **state)
+{
+    (void)state;
+    char path[1024];
+    snprintf(path, sizeof path, "%s/jumps.log", getenv("POSE_TEST_TMP"));
+    FILE *w = fopen(path, "w");
+    assert_non_null(w);
+    fputs("(1.000000) can0 10B#4019010000000000\n"
+          "(1.010000) can0 10B#4019010000000000\n"
+          "(3601.010000) can0 10B#4019010000000000\n"
+          "(3601.020000) can0 10B#4019010000000000\n"
+          "(3600.000000) can0 10B#4019010000000000\n"
+          "(3600.010000) can0 10B#4019010000000000\n",
+          w);
+    fclose(w);
+    const char *const want[] = {"KNEE_L.flex"};
+    pb_source *src = NULL;
+    pb_error err;
+    pb_warnings warnings;
+    memset(&warnings, 0, sizeof warnings);
+    pb_warnings *prev = pb_warnings_install(&warnings);
+    if (pb_candump_replay_open(path, rig_bus(want, 1), NULL, &src, &err) != POSE_OK)
+        fail_msg("%s", err.message);
+    const int64_t t0 = pb_can_mono_ns();
+    pb_update u;
+    for (int i = 0; i < 6; i++) {
+        assert_int_equal(src->ops->read(src, &u, 500), 1);
+        assert_int_equal(u.t_ns, i * 10000000LL);
+    }
+    assert_int_equal(src->ops->read(src, &u, 100), -1);
+    assert_int_equal(src->state, PB_SOURCE_ENDED);
+    assert_true(pb_can_mono_ns() - t0 < 1000000000);
+    pb_warnings_install(prev);
+    assert_int_equal(warnings.count, 2);
+    if (!strstr(warnings.text[0], "jumps.log:3: time stamp jumps ahead 3600.000 s"))
+        fail_msg("%s", warnings.text[0]);
+    if (!strstr(warnings.text[1], "jumps.log:5: time stamp goes back 1.020 s"))
+        fail_msg("%s", warnings.text[1]);
+    pb_source_destroy(src);
+}
+
 static void test_open_errors(void **state)
 {
     (void)state;
@@ -470,6 +516,7 @@ int main(void)
         cmocka_unit_test(test_live_source),
         cmocka_unit_test(test_record_survives_kill),
         cmocka_unit_test(test_reopen_by_name),
+        cmocka_unit_test(test_replay_time_jumps),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

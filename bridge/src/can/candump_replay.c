@@ -13,6 +13,8 @@
 #include <time.h>
 
 #include "candump_log.h"
+#include "pb_warn.h"
+#include "timeline.h"
 
 typedef struct can_replay {
     pb_can_source_core core;
@@ -26,6 +28,7 @@ typedef struct can_replay {
     int64_t start_mono;   /* wall clock at which relative time start_rel was due */
     int64_t start_rel;
     size_t bad_seen;
+    pb_timeline timeline; /* jumps in the log's stamps taken out */
 } can_replay;
 
 static void sleep_ns(int64_t ns)
@@ -48,9 +51,16 @@ static int fetch(can_replay *s)
     }
     if (r != 1)
         return 0;
-    if (s->first_ns == INT64_MIN)
+    if (s->first_ns == INT64_MIN) {
         s->first_ns = s->pending.t_ns;
-    s->pending.t_ns = s->pending.t_ns - s->first_ns + s->loop_base_ns;
+        pb_timeline_init(&s->timeline, 0);
+    }
+    int64_t jump;
+    const int64_t t = pb_timeline_map(&s->timeline, s->pending.t_ns - s->first_ns, &jump);
+    if (jump)
+        pb_warn("%s:%zu: time stamp %s %.3f s: replayed one step after the frame before", s->reader.path,
+                s->reader.line, jump > 0 ? "jumps ahead" : "goes back", (double)(jump > 0 ? jump : -jump) * 1e-9);
+    s->pending.t_ns = t + s->loop_base_ns;
     s->have_pending = 1;
     return 1;
 }

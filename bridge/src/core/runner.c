@@ -14,6 +14,7 @@
 
 #include "clock.h"
 #include "pb_math.h"
+#include "pb_warn.h"
 
 enum { LAG_CAPACITY = 1 << 16 };
 
@@ -46,6 +47,7 @@ struct pb_runner {
     pb_error err;
     pose_status status;
     atomic_int source_state; /* stats.source, for readers that must not lock */
+    pb_warnings *warnings;   /* the starting thread's sink, the bridge thread's from then on */
 };
 
 static void abs_deadline(int64_t t_ns, struct timespec *ts)
@@ -112,11 +114,14 @@ static void tighten_timer_slack(void)
 #endif
 }
 
-/* Real-time scheduling is a request: without the privilege the thread runs
- * normally and stats.realtime says so. Under load it is what keeps the
- * wake-up lag of a 120 Hz replay under a millisecond. */
+/* The bridge thread's set-up: the starting thread's warning sink (a
+ * recording's time jumps and cut lines are found while playing), then the
+ * priority. Real-time scheduling is a request: without the privilege the
+ * thread runs normally and stats.realtime says so. Under load it is what
+ * keeps the wake-up lag of a 120 Hz replay under a millisecond. */
 static void apply_priority(pb_runner *r)
 {
+    pb_warnings_install(r->warnings);
     tighten_timer_slack();
     if (r->opt.rt_priority <= 0)
         return;
@@ -351,6 +356,7 @@ static pose_status runner_new(const pb_rig_skel *rig, const pb_runner_options *o
     if (opt)
         r->opt = *opt;
     r->rig = rig;
+    r->warnings = pb_warnings_current();
     r->speed = r->opt.speed > 0 ? r->opt.speed : 1.0;
     r->paused = r->opt.start_paused;
     r->period = r->opt.rate_hz > 0 ? r->speed / r->opt.rate_hz : frame_time;

@@ -8,7 +8,11 @@
  * Timing: tick k is due at media time k * period (period = frame time, or
  * 1/rate_hz when given: samples between frames are slerped). The thread
  * sleeps until the tick's wall time (CLOCK_MONOTONIC, absolute) and records
- * its lateness ("lag"). speed 0 runs as fast as possible, without sleeping. */
+ * its lateness ("lag"). speed 0 runs as fast as possible, without sleeping.
+ *
+ * Warnings: the bridge thread reports to the pb_warn sink that was installed
+ * on the thread that started it (pose_bridge_open installs the bridge's); that
+ * sink must outlive the runner, and nothing else may write to it meanwhile. */
 #ifndef POSE_BRIDGE_RUNNER_H
 #define POSE_BRIDGE_RUNNER_H
 

@@ -10,6 +10,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "pb_warn.h"
+#include "timeline.h"
+
 typedef struct reader {
     const char *name;
     pb_error *err;
@@ -18,7 +21,7 @@ typedef struct reader {
     size_t event_cap, data_cap;
     uint32_t current;     /* device that D: selected */
     size_t desc_expected; /* bytes an unfinished R: still waits for (0 = none) */
-    int64_t last_t;
+    pb_timeline timeline; /* jumps in the E: stamps taken out */
 } reader;
 
 static pose_status bad(reader *r, const char *what)
@@ -178,10 +181,11 @@ static pose_status event(reader *r, const char *p, const char *end)
         return bad(r, "E: timestamp fraction must have 1 to 9 digits");
     for (size_t i = digits; i < 9; i++)
         frac *= 10;
-    int64_t t = (int64_t)sec * 1000000000 + (int64_t)frac;
-    if (t < r->last_t)
-        return bad(r, "E: timestamp goes backwards");
-    r->last_t = t;
+    int64_t jump;
+    const int64_t t = pb_timeline_map(&r->timeline, (int64_t)sec * 1000000000 + (int64_t)frac, &jump);
+    if (jump) /* kept, so that seeking (by time) and replay stay in order */
+        pb_warn("%s:%u: E: time stamp %s %.3f s: replayed one step after the report before", r->name, r->line,
+                jump > 0 ? "jumps ahead" : "goes back", (double)(jump > 0 ? jump : -jump) * 1e-9);
     uint64_t n;
     p = word_number(skip_blanks(fe, end), end, 10, PB_HID_REC_MAX_EVENT_BYTES, &n);
     if (!p)
@@ -271,7 +275,9 @@ pose_status pb_hid_recording_parse(const char *text, size_t len, const char *nam
                                    pb_error *err)
 {
     *out = NULL;
-    reader r = {.name = name ? name : "hid recording", .err = err};
+    pb_error local;
+    reader r = {.name = name ? name : "hid recording", .err = err ? err : &local};
+    pb_timeline_init(&r.timeline, 0);
     r.rec = calloc(1, sizeof *r.rec);
     if (!r.rec)
         return pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "%s: out of memory", r.name);
@@ -284,10 +290,17 @@ pose_status pb_hid_recording_parse(const char *text, size_t len, const char *nam
         while (te > p && (te[-1] == '\r' || te[-1] == ' ' || te[-1] == '\t'))
             te--;
         r.line++;
+        const char *b = skip_blanks(p, te);
         if (has_nul(p, te))
             st = bad(&r, "NUL byte in a text file");
         else
-            st = line(&r, skip_blanks(p, te), te);
+            st = line(&r, b, te);
+        /* A recorder killed while writing leaves a last E: line without its
+         * newline, its bytes cut short: report it, keep the reports before. */
+        if (st == POSE_ERR_FORMAT && !nl && te - b >= 2 && b[0] == 'E' && b[1] == ':') {
+            pb_warn("%s; the last line is cut (no newline at the end of the file): skipped", r.err->message);
+            st = POSE_OK;
+        }
         p = nl ? nl + 1 : end;
     }
     for (size_t i = 0; st == POSE_OK && i < r.rec->device_count; i++) {
