@@ -5,6 +5,7 @@
 
 #include "alloc.h"
 #include "error.h"
+#include "rig_format.h"
 #include "rig_io.h"
 
 /* A description is serialized into the file image it would have on disk and
@@ -127,4 +128,12 @@ pose_status pose_rig_tet_info(const pose_rig *rig, pose_tet_info *out)
 const char *pose_rig_metadata(const pose_rig *rig)
 {
     return rig ? rig->metadata : "";
+}
+
+_Static_assert(POSE__RIG_VERSION == POSE_RIG_FORMAT_VERSION, "pose.h names the format version the loader reads");
+
+uint32_t pose_rig_format_version(const pose_rig *rig)
+{
+    (void)rig; /* the loader accepts one version, so every rig was loaded from (or writes) it */
+    return POSE__RIG_VERSION;
 }

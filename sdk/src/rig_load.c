@@ -14,9 +14,10 @@
 #include "rig_format.h"
 #include "rig_io.h"
 
+/* A sized struct (pose.h: size 0 reads the 0.1 fields) with a complete allocator. */
 static bool options_valid(const pose_load_options *o)
 {
-    return !o || pose__allocator_valid(&o->allocator);
+    return !o || ((o->size == 0 || o->size >= POSE_LOAD_OPTIONS_SIZE_0_2) && pose__allocator_valid(&o->allocator));
 }
 
 pose_status pose_rig_load(const char *path, pose_rig **out)
@@ -31,7 +32,7 @@ pose_status pose_rig_load_ex(const char *path, const pose_load_options *options,
         *out = NULL;
     if (!path || !out || !options_valid(options))
         return pose__fail(POSE_ERR_INVALID_ARGUMENT,
-                          "pose_rig_load: NULL path/out or incomplete allocator");
+                          "pose_rig_load: NULL path/out, options.size below the 0.2 layout or incomplete allocator");
     uint32_t flags = options ? options->flags & ~(uint32_t)POSE__OPEN_VALIDATE_ONLY : 0;
     const pose_allocator *alloc = options ? &options->allocator : NULL;
     char name[POSE__ERROR_SIZE / 2];
@@ -96,7 +97,7 @@ pose_status pose_rig_load_memory(const void *data, size_t size, const pose_load_
         *out = NULL;
     if (!data || !out || !options_valid(options))
         return pose__fail(POSE_ERR_INVALID_ARGUMENT,
-                          "pose_rig_load_memory: NULL data/out or incomplete allocator");
+                          "pose_rig_load_memory: NULL data/out, options.size below the 0.2 layout or incomplete allocator");
     uint32_t flags = options ? options->flags & ~(uint32_t)POSE__OPEN_VALIDATE_ONLY : 0;
     const pose_allocator *alloc = options ? &options->allocator : NULL;
     if (flags & POSE_LOAD_BORROW) {

@@ -94,6 +94,10 @@ pose_status pose_state_create_ex(const pose_rig *rig, const pose_state_options *
     if (!pose__allocator_valid(&opt.allocator))
         return pose__fail(POSE_ERR_INVALID_ARGUMENT,
                           "pose_state_create: allocator needs both alloc and free");
+    if (opt.size != 0 && opt.size < POSE_STATE_OPTIONS_SIZE_0_2) /* 0: the 0.1 fields (pose.h) */
+        return pose__fail(POSE_ERR_INVALID_ARGUMENT,
+                          "pose_state_create: options.size %zu is below the 0.2 layout (%zu)", opt.size,
+                          (size_t)POSE_STATE_OPTIONS_SIZE_0_2);
     if (opt.threads < 0)
         return pose__fail(POSE_ERR_INVALID_ARGUMENT, "pose_state_create: threads = %d",
                           opt.threads);

@@ -71,6 +71,11 @@ POSE_API int pose_version(void);
 /** Run-time version as "MAJOR.MINOR.PATCH"; static storage. @since 0.1 */
 POSE_API const char *pose_version_string(void);
 
+/** Version of the rig file format this library writes (docs/rig-format.md);
+ *  it reads this version only. A file's version is in its header at byte 8.
+ *  At run time: pose_rig_format_version. @since 0.2 */
+#define POSE_RIG_FORMAT_VERSION 1u
+
 /* ----------------------------------------------------------------- status */
 
 /** Result codes. Codes are only ever appended, never renumbered. */
@@ -170,11 +175,34 @@ enum {
     POSE_LOAD_SKIP_CRC = 1u << 2,
 };
 
+/**
+ * Options structs (pose_load_options, pose_state_options) are zero-default
+ * and carry their own size, as pose/bridge.h's do: set size to sizeof the
+ * struct, or leave it 0. 0 reads the fields the struct had in 0.1 (all but
+ * size), so code written for 0.1 keeps its meaning; fields a later version
+ * appends are read only when size covers them; a non-zero size below the
+ * 0.2 layout is POSE_ERR_INVALID_ARGUMENT.
+ *
+ * ABI: programs built against the 0.1 headers pass the 0.1 layouts (no size)
+ * to pose_rig_load_ex, pose_rig_load_memory and pose_state_create_ex, and the
+ * library keeps those symbols for them; this header maps the three names to
+ * the sized entry points below, so a rebuilt program passes the sized
+ * layout. Bindings that find symbols by name (ctypes, P/Invoke) call the
+ * *_sized symbols.
+ */
+#define pose_rig_load_ex pose_rig_load_ex_sized
+#define pose_rig_load_memory pose_rig_load_memory_sized
+#define pose_state_create_ex pose_state_create_ex_sized
+
 /** Options for loading; a zeroed struct gives the defaults. */
 typedef struct pose_load_options {
+    size_t size;    /**< sizeof(pose_load_options), or 0 (see above) @since 0.2 */
     pose_allocator allocator;
     uint32_t flags; /**< POSE_LOAD_* */
 } pose_load_options;
+
+/** Size of the 0.2 layout of pose_load_options: the least non-zero size accepted. */
+#define POSE_LOAD_OPTIONS_SIZE_0_2 (offsetof(pose_load_options, flags) + sizeof(uint32_t))
 
 /**
  * Load a rig file (memory-mapped; every section validated before use).
@@ -249,6 +277,11 @@ POSE_API pose_status pose_rig_tissue_info(const pose_rig *rig, int tissue, pose_
 POSE_API pose_status pose_rig_tet_info(const pose_rig *rig, pose_tet_info *out);
 /** Free-form provenance text stored in the rig ("" when none); owned by the rig. @since 0.1 */
 POSE_API const char *pose_rig_metadata(const pose_rig *rig);
+/** The rig file format version `rig` was loaded from (a rig made by
+ *  pose_rig_create: the one pose_rig_write_file writes); with NULL, the
+ *  version this library writes, to compare with the POSE_RIG_FORMAT_VERSION
+ *  a program was built with. @since 0.2 */
+POSE_API uint32_t pose_rig_format_version(const pose_rig *rig);
 
 /* ----------------------------------------------------- clinical angles */
 
@@ -404,12 +437,16 @@ POSE_API pose_status pose_rig_write_memory(const pose_rig_desc *desc, const pose
 
 /* ------------------------------------------------------------- instances */
 
-/** Options for a state; a zeroed struct gives the defaults. */
+/** Options for a state; a zeroed struct gives the defaults (size: see pose_load_options). */
 typedef struct pose_state_options {
+    size_t size;        /**< sizeof(pose_state_options), or 0 @since 0.2 */
     pose_allocator allocator;
     int threads;        /**< worker threads for pose_apply; 0 = number of cores */
     pose_method method; /**< initial method (default POSE_LBS) */
 } pose_state_options;
+
+/** Size of the 0.2 layout of pose_state_options: the least non-zero size accepted. */
+#define POSE_STATE_OPTIONS_SIZE_0_2 (offsetof(pose_state_options, method) + sizeof(pose_method))
 
 /** Create a posed instance of `rig`, at rest. @since 0.1 */
 POSE_API pose_status pose_state_create(const pose_rig *rig, pose_state **out);
@@ -492,6 +529,17 @@ POSE_API const float *pose_tissue_normals(const pose_state *state, int tissue, s
 POSE_API const float *pose_tet_positions(const pose_state *state, size_t *vertex_count);
 /** Joint frame in model space after the last pose_apply. @since 0.1 */
 POSE_API pose_status pose_joint_world(const pose_state *state, int joint, pose_transform *out);
+
+/* ---------------------------------------------------------------- bounds */
+
+/**
+ * Axis-aligned bounding box of tissue `tissue` (-1: of every tissue, or of
+ * the tet mesh when the rig has none) at rest. One pass over the vertices,
+ * nothing cached. @since 0.2
+ */
+POSE_API pose_status pose_rig_bounds(const pose_rig *rig, int tissue, float min[3], float max[3]);
+/** The same box of the posed positions after the last pose_apply (rest before the first). @since 0.2 */
+POSE_API pose_status pose_state_bounds(const pose_state *state, int tissue, float min[3], float max[3]);
 
 #ifdef __cplusplus
 }
