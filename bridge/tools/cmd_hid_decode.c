@@ -19,8 +19,8 @@ static void usage(FILE *f)
                "{\"warnings\": [text, ...]} when the descriptors raised warnings (also printed on stderr).\n");
 }
 
-static void print_event(const pb_hid_desc *d, const pb_hid_rec_event *e, const uint8_t *bytes, int json,
-                        int32_t *logical, double *value, uint8_t *valid)
+static void print_event(const char *path, const pb_hid_desc *d, const pb_hid_rec_event *e, const uint8_t *bytes,
+                        int json, int32_t *logical, double *value, uint8_t *valid)
 {
     uint32_t first, count;
     pb_hid_decode_result r = pb_hid_report_decode(d, bytes, e->len, logical, value, valid, &first, &count);
@@ -36,6 +36,10 @@ static void print_event(const pb_hid_desc *d, const pb_hid_rec_event *e, const u
         return;
     }
     unsigned id = d->uses_report_ids ? bytes[0] : 0;
+    const size_t declared = pb_hid_desc_input_length(d, (uint8_t)id);
+    if (e->len > declared) /* decoded all the same: devices pad reports */
+        pb_warn("%s:%u: report of %u bytes, its descriptor declares %zu: the extra bytes are ignored", path, e->line,
+                e->len, declared);
     if (json)
         printf("{\"t\":%.6f,\"device\":%u,\"report_id\":%u,\"values\":{", t, e->device, id);
     else
@@ -135,7 +139,6 @@ static int run(int argc, char **argv)
         fprintf(stderr, "pose-bridge hid-decode: out of memory\n");
         rc = 1;
     }
-    pb_warnings_install(NULL);
     if (json && rc == 0)
         pb_cli_json_warnings_line(stdout, &warnings);
     long shown = 0;
@@ -143,9 +146,10 @@ static int run(int argc, char **argv)
         const pb_hid_rec_event *e = &rec->events[i];
         if (device >= 0 && e->device != (uint32_t)device)
             continue;
-        print_event(descs[e->device], e, rec->data + e->offset, json, logical, value, valid);
+        print_event(path, descs[e->device], e, rec->data + e->offset, json, logical, value, valid);
         shown++;
     }
+    pb_warnings_install(NULL); /* the events' warnings went to stderr as they came */
     for (size_t i = 0; descs && i < rec->device_count; i++)
         pb_hid_desc_free(descs[i]);
     free(descs);

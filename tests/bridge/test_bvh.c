@@ -5,6 +5,7 @@
 #include "mocap.h"
 #include "pb_math.h"
 #include "pb_text.h"
+#include "pb_warn.h"
 
 static const char *HIER =
     "HIERARCHY\n"
@@ -238,6 +239,45 @@ static void test_no_channels(void **state)
     pb_clip_free(c);
 }
 
+/* Values no joint or capture volume can have (1e30 in a BVH, 1e300 in an
+ * AMC) are kept but warned about, naming the line, the first value and the
+ * count; a radians value too large for degrees is refused (it was inf). */
+static void test_absurd_values_warned(void **state)
+{
+    (void)state;
+    pb_warnings w;
+    memset(&w, 0, sizeof w);
+    pb_warnings *prev = pb_warnings_install(&w);
+    char *t = join(HIER, "MOTION\nFrames: 2\nFrame Time: 0.1\n0 0 0 0 0 0 0 0 0 0 0 0 0\n0 0 0 1e30 0 0 0 0 0 0 0 0 -2e7\n");
+    pb_clip *c = NULL;
+    pb_error err = {{0}};
+    assert_int_equal(parse_text(t, &c, &err), POSE_OK);
+    free(t);
+    pb_clip_free(c);
+    assert_int_equal(w.count, 1);
+    if (!strstr(w.text[0], "hand.bvh:34: frame 1 value 3 is 1e+30, beyond +-1e+06") ||
+        !strstr(w.text[0], "2 such values"))
+        fail_msg("%s", w.text[0]);
+
+    static const char asf[] = ":version 1.10\n:name t\n:units\n  angle deg\n:root\n  order TX TY TZ RX RY RZ\n"
+                              "  axis XYZ\n  position 0 0 0\n  orientation 0 0 0\n:bonedata\n  begin\n    id 1\n"
+                              "    name a\n    direction 0 1 0\n    length 1\n    axis 0 0 0 XYZ\n    dof rx\n"
+                              "  end\n:hierarchy\n  begin\n    root a\n  end\n";
+    assert_int_equal(pb_asf_parse(asf, strlen(asf), "t.asf", &c, &err), POSE_OK);
+    static const char amc[] = ":DEGREES\n1\nroot 0 0 0 0 0 0\na 5\n2\nroot 0 0 0 0 0 0\na 1e300\n";
+    if (pb_amc_parse(c, amc, strlen(amc), "t.amc", &err) != POSE_OK)
+        fail_msg("%s", err.message);
+    assert_int_equal(w.count, 2);
+    if (!strstr(w.text[1], "t.amc:7: bone a value 1e+300 is beyond +-1e+06"))
+        fail_msg("%s", w.text[1]);
+    static const char rad[] = ":RADIANS\n1\nroot 0 0 0 0 0 0\na 1e307\n";
+    assert_int_equal(pb_amc_parse(c, rad, strlen(rad), "r.amc", &err), POSE_ERR_FORMAT);
+    if (!strstr(err.message, "r.amc:4: bone a: value 0 is not finite in degrees"))
+        fail_msg("%s", err.message);
+    pb_clip_free(c);
+    pb_warnings_install(prev);
+}
+
 static void test_hand_computed_fk(void **state)
 {
     (void)state;
@@ -340,6 +380,7 @@ int main(void)
         cmocka_unit_test(test_absurd_frame_count),
         cmocka_unit_test(test_structure_errors),
         cmocka_unit_test(test_no_channels),
+        cmocka_unit_test(test_absurd_values_warned),
         cmocka_unit_test(test_missing_file),
         cmocka_unit_test(test_hand_computed_fk),
         cmocka_unit_test(test_crlf_and_trailing_blanks),

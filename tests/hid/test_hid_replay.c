@@ -17,6 +17,7 @@
 #include "hid_hidraw.h"
 #include "hid_mannequin.h"
 #include "hid_open.h"
+#include "pb_warn.h"
 
 static void data_path(char *buf, size_t n, const char *file)
 {
@@ -356,6 +357,41 @@ static void test_seek_and_loop(void **state)
     pb_source_destroy(src);
 }
 
+/* A report longer than its descriptor declares is decoded (devices pad) but
+ * no longer in silence: one warning names the device and both lengths. */
+static void test_long_report_warned(void **state)
+{
+    (void)state;
+    char path[1024];
+    snprintf(path, sizeof path, "%s/long_report.hid", getenv("POSE_TEST_TMP"));
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("R: 52 05 01 09 02 a1 01 09 01 a1 00 05 09 19 01 29 03 15 00 25 01 95 03 75 01 81 02 95 01 75 05 81 "
+          "01 05 01 09 30 09 31 09 38 15 81 25 7f 75 08 95 03 81 06 c0 c0\n"
+          "E: 000000.000100 4 05 fe 02 01\n"
+          "E: 000000.000200 6 05 fe 02 01 00 00\n"
+          "E: 000000.000300 6 05 fe 02 01 00 00\n",
+          f);
+    fclose(f);
+    pb_warnings w;
+    memset(&w, 0, sizeof w);
+    pb_warnings *prev = pb_warnings_install(&w);
+    pb_hid_replay_options opt = {.as_fast_as_possible = 1};
+    pb_source *src = NULL;
+    pb_error err;
+    if (pb_hid_replay_open(path, &opt, &src, &err) != POSE_OK)
+        fail_msg("%s", err.message);
+    pb_update u;
+    for (int i = 0; i < 3; i++)
+        assert_int_equal(pb_source_read(src, &u, 100), 1);
+    pb_warnings_install(prev);
+    assert_int_equal(src->state, PB_SOURCE_OK);
+    assert_int_equal(w.count, 1);
+    if (!strstr(w.text[0], "long_report.hid: report of 6 bytes, its descriptor declares 4"))
+        fail_msg("%s", w.text[0]);
+    pb_source_destroy(src);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -366,6 +402,7 @@ int main(void)
         cmocka_unit_test(test_expected_descriptor),
         cmocka_unit_test(test_hold_pose),
         cmocka_unit_test(test_seek_and_loop),
+        cmocka_unit_test(test_long_report_warned),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

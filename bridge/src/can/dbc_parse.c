@@ -403,10 +403,18 @@ static void skip_statement(parser *ps)
     }
 }
 
+/* The rest of a line the parser does not use (BU_'s and SG_'s node lists,
+ * BS_). Bytes that are not text there (NUL, 0xFF: a binary file, a broken
+ * encoding) are named once per line, not skipped without a word. */
 static void skip_line(parser *ps, size_t line)
 {
-    while (peek(ps)->kind != T_EOF && peek(ps)->line == line)
-        next(ps);
+    int warned = 0;
+    while (peek(ps)->kind != T_EOF && peek(ps)->line == line) {
+        token t = next(ps);
+        const unsigned char c = (unsigned char)t.s[0];
+        if (t.kind == T_PUNCT && (c == 0x00 || c == 0xFF) && !warned++)
+            warn_at(ps, line, "byte 0x%02X at column %zu is not text (in a node list, skipped)", c, t.col + 1);
+    }
 }
 
 static pb_dbc_message *find_message_raw(parser *ps, uint64_t raw_id)
@@ -616,6 +624,8 @@ static void parse_sg(parser *ps, size_t line)
     s->has_mux_value = (uint8_t)has_mux_value;
     s->mux_value = mux_value;
     s->line = line;
+    if (factor == 0.0)
+        warn_at(ps, line, "signal %s has factor 0: it always reads its offset %g", s->name, offset);
 }
 
 static int cmp_choice(const void *a, const void *b)
@@ -769,6 +779,61 @@ static void resolve_multiplexing(parser *ps)
     }
 }
 
+/* The frame bits a signal occupies, as a 512-bit set (bit 8*byte + bit). */
+static void signal_bits(const pb_dbc_signal *s, uint64_t bits[8])
+{
+    memset(bits, 0, 8 * sizeof *bits);
+    for (unsigned k = 0; k < s->length; k++) {
+        const unsigned lin = s->linear_start + k;
+        const unsigned bit = s->intel ? lin : lin / 8 * 8 + (7 - lin % 8);
+        bits[bit / 64] |= UINT64_C(1) << (bit % 64);
+    }
+}
+
+static int mux_ranges_meet(const pb_dbc_signal *a, const pb_dbc_signal *b)
+{
+    for (size_t i = 0; i < a->mux_range_count; i++)
+        for (size_t j = 0; j < b->mux_range_count; j++)
+            if (a->mux_ranges[i].lo <= b->mux_ranges[j].hi && b->mux_ranges[j].lo <= a->mux_ranges[i].hi)
+                return 1;
+    return 0;
+}
+
+/* Signals of one message that share bits while both can be present (neither
+ * multiplexed, one multiplexed, or both by the same multiplexor for a common
+ * value) decode each other's bits: a warning, once per signal. Signals of
+ * different multiplexors are not compared. Pairwise: messages hold tens of
+ * signals; those with more than 1024 are not checked. */
+static void check_overlaps(parser *ps)
+{
+    const pb_dbc *d = ps->dbc;
+    for (size_t i = 0; i < d->message_count; i++) {
+        const pb_dbc_message *m = &d->messages[i];
+        if (m->signal_count < 2 || m->signal_count > 1024)
+            continue;
+        uint64_t(*bits)[8] = scratch_reserve(ps, m->signal_count * sizeof *bits);
+        for (size_t j = 0; j < m->signal_count; j++)
+            signal_bits(&m->signals[j], bits[j]);
+        for (size_t j = 1; j < m->signal_count; j++) {
+            const pb_dbc_signal *a = &m->signals[j];
+            for (size_t k = 0; k < j; k++) {
+                const pb_dbc_signal *b = &m->signals[k];
+                if (a->muxed_by >= 0 && b->muxed_by >= 0 &&
+                    (a->muxed_by != b->muxed_by || !mux_ranges_meet(a, b)))
+                    continue;
+                uint64_t common = 0;
+                for (int w = 0; w < 8; w++)
+                    common |= bits[j][w] & bits[k][w];
+                if (common) {
+                    warn_at(ps, a->line, "signal %s overlaps signal %s (line %zu) in message %s", a->name, b->name,
+                            b->line, m->name);
+                    break;
+                }
+            }
+        }
+    }
+}
+
 static int cmp_index(const void *a, const void *b)
 {
     const struct pb_dbc_index_entry *x = a, *y = b;
@@ -882,6 +947,7 @@ static void parse_all(parser *ps)
         }
     }
     resolve_multiplexing(ps);
+    check_overlaps(ps);
     build_index(ps);
 }
 

@@ -8,6 +8,7 @@
 #include <time.h>
 
 #include "hid_report.h"
+#include "pb_warn.h"
 
 typedef struct hid_source {
     pb_source base; /* first: a pb_source * is a hid_source * */
@@ -21,6 +22,7 @@ typedef struct hid_source {
     int64_t last_rx_ns;     /* monotonic time of the last report, good or not (silence is measured from it) */
     int64_t next_reopen_ns;
     pb_hid_decode_result last_fault;
+    int long_warned; /* a report longer than its descriptor says was reported (once) */
     int32_t *logical;
     double *values;
     uint8_t *valid;
@@ -277,6 +279,13 @@ static int hid_read(pb_source *src, pb_update *out, int timeout_ms)
             continue;
         }
         s->stats.reports++;
+        const size_t declared =
+            pb_hid_desc_input_length(s->desc, s->desc->uses_report_ids ? s->report[0] : 0);
+        /* Devices pad reports, so the extra bytes are ignored; said once, not at 1 kHz. */
+        if (s->report_len > declared && !s->long_warned++)
+            pb_warn("%s: report of %zu bytes, its descriptor declares %zu: the extra bytes are ignored (reported "
+                    "once)",
+                    s->t->origin, s->report_len, declared);
         if (s->base.state != PB_SOURCE_OK)
             pb_source_set_state(&s->base, PB_SOURCE_OK, "%s: receiving", s->t->origin);
         return deliver(s, out, t_ns, first, count);

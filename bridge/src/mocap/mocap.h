@@ -21,6 +21,12 @@
 
 enum { PB_MAX_JOINTS = 4096, PB_NAME_MAX = 64 };
 
+/** Channel values beyond +-this are warned about (pb_warn) and kept: no joint
+ *  turns a million degrees and no capture volume is a million length units
+ *  (a kilometre in mm) across, so such a value is corrupt data, and FK turns
+ *  it into a pose without meaning. */
+#define PB_MOCAP_VALUE_MAX 1e6
+
 typedef enum pb_chan_kind {
     PB_CH_XPOS = 0, PB_CH_YPOS = 1, PB_CH_ZPOS = 2,
     PB_CH_XROT = 3, PB_CH_YROT = 4, PB_CH_ZROT = 5,

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0
  * Acclaim AMC motion reader (fully specified: every bone with dofs appears
  * once per frame, values in its dof order; the root in `:root order`). */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -8,6 +9,7 @@
 #include "mocap.h"
 #include "pb_math.h"
 #include "pb_text.h"
+#include "pb_warn.h"
 
 enum { AMC_MAX_FILE = 1u << 30 };
 
@@ -46,6 +48,10 @@ pose_status pb_amc_parse(pb_clip *clip, const char *text, size_t size, const cha
     double *frames = NULL;
     size_t count = 0, cap = 0;
     long first_number = -1;
+    size_t absurd = 0; /* values beyond PB_MOCAP_VALUE_MAX; the first one's place and value: */
+    long absurd_line = 0;
+    double absurd_value = 0;
+    const char *absurd_bone = "";
     unsigned char *seen = calloc((size_t)clip->joint_count + 1, 1);
     pose_status s = seen ? POSE_OK : pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "out of memory");
     char buf[64];
@@ -138,8 +144,18 @@ pose_status pb_amc_parse(pb_clip *clip, const char *text, size_t size, const cha
                 s = pb_fail(err, POSE_ERR_FORMAT, "%s:%ld: bone %s: expected %d %svalues, %s", T.name, tk.line,
                             J->name, J->chan_count, rc == -2 ? "finite " : "",
                             n.n ? "found a non-number" : "found fewer");
-            else if (J->chan[c] >= PB_CH_XROT && J->chan[c] <= PB_CH_ZROT)
-                v[c] *= angle_scale;
+            else {
+                if (J->chan[c] >= PB_CH_XROT && J->chan[c] <= PB_CH_ZROT)
+                    v[c] *= angle_scale;
+                if (!isfinite(v[c])) /* finite radians, too many degrees */
+                    s = pb_fail(err, POSE_ERR_FORMAT, "%s:%ld: bone %s: value %d is not finite in degrees", T.name,
+                                tk.line, J->name, c);
+                else if (fabs(v[c]) > PB_MOCAP_VALUE_MAX && !absurd++) {
+                    absurd_line = tk.line;
+                    absurd_value = v[c];
+                    absurd_bone = J->name;
+                }
+            }
         }
         if (!s && pb_text_next_in_line(&T).n != 0)
             s = pb_fail(err, POSE_ERR_FORMAT, "%s:%ld: bone %s: more than %d values", T.name, tk.line, J->name,
@@ -154,6 +170,10 @@ pose_status pb_amc_parse(pb_clip *clip, const char *text, size_t size, const cha
             }
     if (!s && count == 0)
         s = pb_fail(err, POSE_ERR_FORMAT, "%s:%ld: no frames", T.name, T.line);
+    if (!s && absurd)
+        pb_warn("%s:%ld: bone %s value %g is beyond +-%g (degrees or length units): kept; %zu such values in the "
+                "file",
+                T.name, absurd_line, absurd_bone, absurd_value, PB_MOCAP_VALUE_MAX, absurd);
     free(seen);
     free(copy);
     if (s) {

@@ -3,6 +3,7 @@
  * and the format is a small token grammar. Accepts any number (0..6) and
  * order of channels per joint, any rotation order, End Sites, CRLF, tabs and
  * trailing blanks. Every error names file, line and what was expected. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,6 +11,7 @@
 #include "mocap.h"
 #include "pb_math.h"
 #include "pb_text.h"
+#include "pb_warn.h"
 
 enum { BVH_MAX_DEPTH = 256, BVH_MAX_FILE = 1u << 30 };
 
@@ -203,6 +205,10 @@ static pose_status parse_motion(bvh_parser *P)
     }
     pb_text_skip_line(&P->t); /* rest of the Frame Time line */
     double *v = c->frames;
+    size_t absurd = 0; /* values beyond PB_MOCAP_VALUE_MAX; the first one's place and value: */
+    long absurd_line = 0, absurd_frame = 0;
+    size_t absurd_index = 0;
+    double absurd_value = 0;
     for (long f = 0; f < frames; f++) {
         pb_text_skip_space(&P->t, 0);
         long line = P->t.line;
@@ -218,6 +224,12 @@ static pose_status parse_motion(bvh_parser *P)
                 return pb_fail(P->err, POSE_ERR_FORMAT, "%s:%ld: frame %ld value %zu: expected a %snumber, found '%s'",
                                P->t.name, line, f, k, rc == -2 ? "finite " : "", pb_token_str(n, buf, sizeof buf));
             }
+            if (fabs(*v) > PB_MOCAP_VALUE_MAX && !absurd++) {
+                absurd_line = line;
+                absurd_frame = f;
+                absurd_index = k;
+                absurd_value = *v;
+            }
             v++;
         }
         pb_token extra = pb_text_next_in_line(&P->t);
@@ -229,6 +241,10 @@ static pose_status parse_motion(bvh_parser *P)
     if (rest.n != 0)
         return pb_fail(P->err, POSE_ERR_FORMAT, "%s:%ld: data after the %ld frames that 'Frames:' announced",
                        P->t.name, rest.line, frames);
+    if (absurd)
+        pb_warn("%s:%ld: frame %ld value %zu is %g, beyond +-%g (degrees or length units): kept; %zu such values "
+                "in the file",
+                P->t.name, absurd_line, absurd_frame, absurd_index, absurd_value, PB_MOCAP_VALUE_MAX, absurd);
     return POSE_OK;
 }
 
