@@ -71,7 +71,9 @@ pose_status pose_local_to_clinical(const pose_rig *rig, int joint, const float q
     if (hint_deg)
         for (int i = 0; i < 3; i++)
             hint[i] = hint_deg[i];
-    pose__clinical_from_local(&f, r, q, hint_deg ? POSE__PICK_HINT : POSE__PICK_INSIDE, hint, d);
+    pose__clinical_range range; /* the rig's, not any state's (pose_set_joint_range) */
+    pose__clinical_range_of(r, &range);
+    pose__clinical_from_local(&f, &range, q, hint_deg ? POSE__PICK_HINT : POSE__PICK_INSIDE, hint, d);
     for (int i = 0; i < 3; i++)
         deg[i] = (float)d[i];
     return POSE_OK;

@@ -110,16 +110,26 @@ static double fit_angle(double *a, double lo, double hi)
     return above <= below ? above : below;
 }
 
-double pose__clinical_fit(const pose__clinical_record *r, double deg[3])
+void pose__clinical_range_of(const pose__clinical_record *r, pose__clinical_range *out)
+{
+    out->limit_flags = r->limit_flags & (POSE_LIMIT_X | POSE_LIMIT_Y | POSE_LIMIT_Z);
+    for (int a = 0; a < 3; a++) {
+        int limited = (out->limit_flags >> a) & 1u;
+        out->min_deg[a] = limited ? r->limit_min_deg[a] : -180.0f;
+        out->max_deg[a] = limited ? r->limit_max_deg[a] : 180.0f;
+    }
+}
+
+double pose__clinical_fit(const pose__clinical_range *r, double deg[3])
 {
     double excess = 0.0;
     for (int a = 0; a < 3; a++)
         if (r->limit_flags & (1u << a))
-            excess += fit_angle(&deg[a], r->limit_min_deg[a], r->limit_max_deg[a]);
+            excess += fit_angle(&deg[a], r->min_deg[a], r->max_deg[a]);
     return excess;
 }
 
-static double excess_of(const pose__clinical_record *r, const double deg[3])
+static double excess_of(const pose__clinical_range *r, const double deg[3])
 {
     double copy[3] = {deg[0], deg[1], deg[2]};
     return pose__clinical_fit(r, copy);
@@ -144,7 +154,7 @@ static int decompose(const pose__clinical_frame *f, const double q[4], double de
     return locked;
 }
 
-void pose__clinical_from_local(const pose__clinical_frame *f, const pose__clinical_record *r,
+void pose__clinical_from_local(const pose__clinical_frame *f, const pose__clinical_range *r,
                                const double q[4], pose__clinical_pick pick, const double hint[3],
                                double deg[3])
 {
@@ -155,7 +165,7 @@ void pose__clinical_from_local(const pose__clinical_frame *f, const pose__clinic
         if (pick == POSE__PICK_HINT)
             c = hint[2];
         else if (r->limit_flags & POSE_LIMIT_Z)
-            fit_angle(&c, r->limit_min_deg[2], r->limit_max_deg[2]);
+            fit_angle(&c, r->min_deg[2], r->max_deg[2]);
         d[0] = wrap(d[0] - (d[1] > 0.0 ? 1.0 : -1.0) * f->handed * c);
         d[2] = c;
     } else {

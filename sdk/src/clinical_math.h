@@ -22,6 +22,14 @@ typedef struct pose__clinical_frame {
                             axis is then -basis z, so its angle changes sign */
 } pose__clinical_frame;
 
+/** A range of motion over the three clinical angles: the rig's (from its
+ *  record) or a state's own (pose_set_joint_range). */
+typedef struct pose__clinical_range {
+    uint32_t limit_flags;    /**< POSE_LIMIT_X/_Y/_Z: deg[0]/[1]/[2] limited */
+    float min_deg[3];        /**< unlimited angles: -180 */
+    float max_deg[3];        /**< unlimited angles: 180 */
+} pose__clinical_range;
+
 /** How pose__clinical_from_local picks one of the two angle triples. */
 typedef enum pose__clinical_pick {
     POSE__PICK_HINT,          /**< nearest the hint (angle-wise, wrapping) */
@@ -32,10 +40,12 @@ typedef enum pose__clinical_pick {
 /** Frame of a (validated) record: the axes are orthonormalized from the
  *  flexion axis on, so conversions both ways use exactly the same frame. */
 void pose__clinical_frame_of(const pose__clinical_record *r, pose__clinical_frame *f);
+/** The range a (validated) record stores. */
+void pose__clinical_range_of(const pose__clinical_record *r, pose__clinical_range *out);
 /** Clinical angles (degrees) -> local rotation, no limits. */
 void pose__clinical_to_local(const pose__clinical_frame *f, const double deg[3], double q[4]);
 /**
- * Local rotation -> clinical angles. Every rotation has two triples, (f, a, r)
+ * Local rotation -> clinical angles, `r` giving the limits. Every rotation has two triples, (f, a, r)
  * and (f + 180, 180 - a, r + 180); `pick` chooses (hint: {f, a, r} or NULL
  * unless POSE__PICK_HINT). Limited angles are moved by whole turns into, or
  * nearest to, their range (flexion 180 stays 180 with a range [-60, 180]);
@@ -43,7 +53,7 @@ void pose__clinical_to_local(const pose__clinical_frame *f, const double deg[3],
  * lock (abduction +-90) only f +- r is defined: r is taken from the hint,
  * else 0 (moved into r's range when limited), and f carries the rest.
  */
-void pose__clinical_from_local(const pose__clinical_frame *f, const pose__clinical_record *r,
+void pose__clinical_from_local(const pose__clinical_frame *f, const pose__clinical_range *r,
                                const double q[4], pose__clinical_pick pick, const double hint[3],
                                double deg[3]);
 /**
@@ -51,6 +61,6 @@ void pose__clinical_from_local(const pose__clinical_frame *f, const pose__clinic
  * in range is unchanged); returns the degrees by which they still lie
  * outside, summed.
  */
-double pose__clinical_fit(const pose__clinical_record *r, double deg[3]);
+double pose__clinical_fit(const pose__clinical_range *r, double deg[3]);
 
 #endif /* POSE_CLINICAL_MATH_H */

@@ -109,7 +109,8 @@ pose_status pose_state_create_ex(const pose_rig *rig, const pose_state_options *
     const size_t nt = rig->rt->transfer.vertex_count;
     size_t off_local = align64(sizeof(pose_state));
     size_t off_clinical = off_local + align64(nj * sizeof(float[4]));
-    size_t off_skin = off_clinical + align64(nj * sizeof(float[3]));
+    size_t off_ranges = off_clinical + align64(nj * sizeof(float[3]));
+    size_t off_skin = off_ranges + align64(nj * sizeof(pose__clinical_range));
     size_t off_world = off_skin + align64(nj * sizeof(pose__xform));
     size_t off_palette = off_world + align64(nj * sizeof(pose__xform));
     size_t off_tet = off_palette + align64(nj * sizeof(pose__skin_joint));
@@ -134,6 +135,7 @@ pose_status pose_state_create_ex(const pose_rig *rig, const pose_state_options *
     st->block = block;
     st->local = (float(*)[4])(block + off_local);
     st->clinical = (float(*)[3])(block + off_clinical);
+    st->ranges = (pose__clinical_range *)(block + off_ranges);
     st->skin = (pose__xform *)(block + off_skin);
     st->world = (pose__xform *)(block + off_world);
     st->palette = (pose__skin_joint *)(block + off_palette);
@@ -144,6 +146,7 @@ pose_status pose_state_create_ex(const pose_rig *rig, const pose_state_options *
     st->flagged_count = (size_t *)(block + off_counts);
     for (size_t j = 0; j < nj; j++)
         pose__quat_identity(st->local[j]);
+    pose__state_rig_ranges(st);
     pose__state_rest_clinical(st);
     pose__xform_identity(&st->root);
     set_rest_outputs(st);

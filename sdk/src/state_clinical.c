@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* pose_state in clinical angles: the clinical setter and getter, the neutral
  * posture, and the clinical range of motion that every setter of a joint
- * with clinical data goes through. The state keeps each such joint's last
+ * with clinical data goes through (the state's own: pose_set_joint_range,
+ * state_range.c). The state keeps each such joint's last
  * angles, so a getter returns the triple that was asked for rather than
  * whichever of the two equivalent triples a decomposition finds. */
 #include <math.h>
@@ -19,20 +20,20 @@
 /* Clamp the limited angles (already moved by whole turns nearest their
  * range) to the range; on a clamp, say which angles and by how much. */
 static int clamp_clinical(int joint, const char *joint_name, const pose__clinical_record *r,
-                          double deg[3])
+                          const pose__clinical_range *range, double deg[3])
 {
     char msg[POSE__ERROR_SIZE];
     size_t len = 0;
     int clamped = 0;
     for (int a = 0; a < 3; a++) {
-        if (!(r->limit_flags & (1u << a)))
+        if (!(range->limit_flags & (1u << a)))
             continue;
-        double v = deg[a], c = fmin(fmax(v, (double)r->limit_min_deg[a]), (double)r->limit_max_deg[a]);
+        double v = deg[a], c = fmin(fmax(v, (double)range->min_deg[a]), (double)range->max_deg[a]);
         if (fabs(c - v) <= CLAMP_TOLERANCE_DEG)
             continue;
         int n = snprintf(msg + len, sizeof msg - len, "%s%s %.2f clamped to %.2f by %.2f [%.2f, %.2f]",
                          clamped ? ", " : "", r->names[a], v, c, fabs(v - c),
-                         (double)r->limit_min_deg[a], (double)r->limit_max_deg[a]);
+                         (double)range->min_deg[a], (double)range->max_deg[a]);
         if (n > 0 && (size_t)n < sizeof msg - len)
             len += (size_t)n;
         deg[a] = c;
@@ -58,8 +59,9 @@ pose_status pose__state_store_clinical(pose_state *st, int joint, const float q[
     pose__clinical_frame f;
     pose__clinical_frame_of(r, &f);
     double qd[4] = {q[0], q[1], q[2], q[3]}, deg[3];
-    pose__clinical_from_local(&f, r, qd, POSE__PICK_NEAREST_LIMITS, NULL, deg);
-    int clamped = clamp_clinical(joint, pose__joint_name(st->rig, (size_t)joint), r, deg);
+    const pose__clinical_range *range = &st->ranges[joint];
+    pose__clinical_from_local(&f, range, qd, POSE__PICK_NEAREST_LIMITS, NULL, deg);
+    int clamped = clamp_clinical(joint, pose__joint_name(st->rig, (size_t)joint), r, range, deg);
     if (clamped)
         pose__clinical_to_local(&f, deg, qd);
     store(st, joint, qd, deg);
@@ -72,8 +74,9 @@ static pose_status set_clinical(pose_state *st, int joint, const pose__clinical_
                                 const double want[3])
 {
     double deg[3] = {want[0], want[1], want[2]}, q[4];
-    pose__clinical_fit(r, deg);
-    int clamped = clamp_clinical(joint, pose__joint_name(st->rig, (size_t)joint), r, deg);
+    const pose__clinical_range *range = &st->ranges[joint];
+    pose__clinical_fit(range, deg);
+    int clamped = clamp_clinical(joint, pose__joint_name(st->rig, (size_t)joint), r, range, deg);
     pose__clinical_frame f;
     pose__clinical_frame_of(r, &f);
     pose__clinical_to_local(&f, deg, q);
@@ -152,7 +155,7 @@ void pose__state_rest_clinical(pose_state *st)
         pose__clinical_frame_of(r, &f);
         static const double identity[4] = {0.0, 0.0, 0.0, 1.0};
         double deg[3];
-        pose__clinical_from_local(&f, r, identity, POSE__PICK_NEAREST_LIMITS, NULL, deg);
+        pose__clinical_from_local(&f, &st->ranges[j], identity, POSE__PICK_NEAREST_LIMITS, NULL, deg);
         for (int i = 0; i < 3; i++)
             st->clinical[j][i] = (float)deg[i];
     }

@@ -8,6 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "clinical_math.h"
 #include "pose/pose.h"
 #include "rig_internal.h"
 #include "rig_runtime.h"
@@ -24,6 +25,8 @@ struct pose_state {
     float (*local)[4];          /**< joint_count local rotations relative to rest */
     float (*clinical)[3];       /**< joint_count: last clinical angles of joints with
                                      clinical data (the triple nearest the last request) */
+    pose__clinical_range *ranges; /**< joint_count: the range of motion each setter clamps
+                                     to (joints with clinical data; pose_set_joint_range) */
     pose__xform root;           /**< model placement on top of the roots */
     pose__xform *skin;          /**< joint_count: rest -> posed, model space */
     pose__xform *world;         /**< joint_count: posed joint frames */
@@ -59,5 +62,7 @@ pose_status pose__state_store_joint(pose_state *st, int joint, float q[4]);
 pose_status pose__state_store_clinical(pose_state *st, int joint, const float q[4]);
 /** Clinical angles of the rest pose for every joint with clinical data. */
 void pose__state_rest_clinical(pose_state *st);
+/** Every joint with clinical data back to the rig's range of motion. */
+void pose__state_rig_ranges(pose_state *st);
 
 #endif /* POSE_STATE_INTERNAL_H */

@@ -3,20 +3,24 @@
  * preprocess/templates/full_body.json (fixture bridge_body_bake writes
  * $POSE_TEST_TMP/body.rig): the rig's real rest frames, neutral posture and
  * clinical ranges, as the demo uses them. Every frame goes through libpose
- * (pose_set_joint, so with its clamping); per segment kind the angle between
- * the rig's segment and the clip's, median and worst, and the share of
- * frames in which any joint was clamped.
+ * (pose_set_joint, so with its clamping) on a state given the map's ranges
+ * of motion as a host gets them (pb_mapping_apply_ranges; the public API's
+ * own path is checked too); per segment kind the angle between the rig's
+ * segment and the clip's, median and worst, the share of frames in which any
+ * joint was clamped, and per joint and angle by how much.
  *
  * Issue 10's acceptance: forearm and trunk within 5 degrees of the clip's
- * (median). Before: forearms 7-8 (the baked elbow's axis lies 10 degrees off
- * the perpendicular to the humerus, CMU's on it, and the rig's rest elbow
- * carries 12 degrees across it), trunk 6-7 (the rig's thorax followed a
- * clip joint that turns the neck).
+ * (median), fewer than 5% of frames clamping. Before: forearms 7-8 (the baked
+ * elbow's axis lies 10 degrees off the perpendicular to the humerus, CMU's on
+ * it, and the rig's rest elbow carries 12 degrees across it), trunk 6-7 (the
+ * rig's thorax followed a clip joint that turns the neck); 01_01 clamped in
+ * 14.6% of its frames under the rig's AAOS ranges, 131_01 in 32.6%.
  */
 #include "bridge_apply.h"
 #include "bridge_test.h"
 #include "mapping.h"
 #include "pb_math.h"
+#include "pose/bridge.h"
 
 /* The limb and trunk segments compared, by kind; each case names the clip
  * joints at their ends in the rig's order of SEG_RIG. */
@@ -35,7 +39,7 @@ static const struct {
 typedef struct body_case {
     const char *clip, *skeleton, *map;
     const char *seg[NSEG][2];
-    double max_clamped; /* share of frames that may clamp a joint, see run_case */
+    double max_clamped; /* share of frames that may clamp a joint, see CASES */
 } body_case;
 
 static const body_case CASES[] = {
@@ -51,7 +55,14 @@ static const body_case CASES[] = {
       {"LeftShoulder", "LeftElbow"},
       {"LeftElbow", "LeftWrist"},
       {"Hips", "lowerneck"}},
-     0.34},
+     /* Not the 5% issue 10 asks for: the right hand deviates radially by
+      * 20-50 degrees from its mean posture in a fifth of the frames (near
+      * 40 for 80 frames with the arm raised), where AAOS gives the wrist 20
+      * and daily activities use at most 17 (Ryu et al. 1991): the hand's
+      * markers, not a range to widen. The left foot turns inward by up to
+      * 40 about the shank (the template's 25). Held at what it is so that it
+      * does not grow. */
+     0.31},
     {"mocap/cmu-bvh/01_01.bvh",
      NULL,
      "cmu_cgspeed_bvh_to_full_body.json",
@@ -64,7 +75,7 @@ static const body_case CASES[] = {
       {"LeftArm", "LeftForeArm"},
       {"LeftForeArm", "LeftHand"},
       {"Hips", "Neck"}},
-     0.16},
+     0.05},
     {"mocap/cmu-asf-amc/01_01.amc",
      "mocap/cmu-asf-amc/01.asf",
      "cmu_asf_to_full_body.json",
@@ -77,7 +88,7 @@ static const body_case CASES[] = {
       {"lhumerus", "lradius"},
       {"lradius", "lwrist"},
       {"root", "lowerneck"}},
-     0.16},
+     0.05},
 };
 
 typedef struct fixture {
@@ -132,6 +143,37 @@ static double median(double *v, size_t n)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+/* Degrees by which libpose clamped one angle of one joint at one end of its
+ * range, over a clip. */
+typedef struct excess {
+    double *deg;   /* one per clamped frame */
+    size_t n;
+} excess;
+
+static const char *const ANGLE[3] = {"flexion", "abduction", "rotation"};
+
+/* Per joint that clamped: in how many frames, and per angle and end of its
+ * range by how much (the request, read back as the clinical angles nearest
+ * the result, against the result): whether what remains is noise at a
+ * range's edge or a posture past it. */
+static void print_excess(const fixture *fx, const long *clamps, excess (*ex)[3][2])
+{
+    for (int j = 0; j < fx->skel->joint_count; j++) {
+        if (!clamps[j])
+            continue;
+        print_message("  %-11s clamped in %ld frames\n", fx->skel->joints[j].name, clamps[j]);
+        for (int a = 0; a < 6; a++) {
+            excess *e = &ex[j][a / 2][a % 2];
+            if (!e->n)
+                continue;
+            qsort(e->deg, e->n, sizeof *e->deg, cmp_double);
+            print_message("    %-9s %s its range in %4zu frames by: median %5.1f, 90%% %5.1f, max %5.1f deg\n",
+                          ANGLE[a / 2], a % 2 ? "above" : "below", e->n, e->deg[e->n / 2], e->deg[e->n * 9 / 10],
+                          e->deg[e->n - 1]);
+        }
+    }
+}
+
 typedef struct body_stats {
     double median_deg[KINDS], max_deg[KINDS];
     size_t max_frame[KINDS];
@@ -165,12 +207,19 @@ static void measure(const fixture *fx, const body_case *bc, body_stats *out)
         }
     pose_state *st;
     assert_int_equal(pose_state_create(fx->rig, &st), POSE_OK);
+    if (pb_mapping_apply_ranges(map, fx->skel, st, &err) != POSE_OK)
+        fail_msg("%s", err.message);
     size_t nc = (size_t)clip->joint_count, nr = (size_t)fx->skel->joint_count, nf = clip->frame_count;
     double (*lq)[4] = malloc(nc * sizeof *lq), (*lt)[3] = malloc(nc * sizeof *lt);
     double (*cq)[4] = malloc(nc * sizeof *cq), (*cp)[3] = malloc(nc * sizeof *cp);
     double (*rq)[4] = malloc(nr * sizeof *rq), (*rp)[3] = malloc(nr * sizeof *rp);
     float (*q)[4] = malloc(nr * sizeof *q);
     long *clamps = calloc(nr, sizeof *clamps);
+    excess (*ex)[3][2] = calloc(nr, sizeof *ex);
+    assert_non_null(ex);
+    for (size_t j = 0; j < nr; j++)
+        for (int a = 0; a < 6; a++)
+            assert_non_null(ex[j][a / 2][a % 2].deg = malloc(nf * sizeof(double)));
     double *ang[KINDS];
     size_t na[KINDS] = {0};
     for (int k = 0; k < KINDS; k++)
@@ -194,6 +243,16 @@ static void measure(const fixture *fx, const body_case *bc, body_stats *out)
             clamps[j] += s == POSE_CLAMPED;
             any |= s == POSE_CLAMPED;
             assert_int_equal(pose_get_joint(st, (int)j, q[j]), POSE_OK);
+            float got[3], want[3];
+            if (s == POSE_CLAMPED && pose_get_joint_clinical(st, (int)j, got) == POSE_OK) {
+                assert_int_equal(pose_local_to_clinical(fx->rig, (int)j, pose.q[j], got, want), POSE_OK);
+                for (int a = 0; a < 3; a++) {
+                    double d = (double)want[a] - got[a];
+                    excess *e = &ex[j][a][d > 0];
+                    if (fabs(d) > 1e-3)
+                        e->deg[e->n++] = fabs(d);
+                }
+            }
         }
         clamped_frames += any;
         pb_rig_skel_fk(fx->skel, (const float (*)[4])q, pose.root_t, pose.root_q, rq, rp);
@@ -217,9 +276,7 @@ static void measure(const fixture *fx, const body_case *bc, body_stats *out)
     out->clamped_frames = (double)clamped_frames / (double)nf;
     print_message("%s onto the baked body, %zu frames: %.1f%% clamp a joint\n", bc->clip, nf,
                   100.0 * out->clamped_frames);
-    for (size_t j = 0; j < nr; j++)
-        if (clamps[j])
-            print_message("  %-11s clamped in %ld frames\n", fx->skel->joints[j].name, clamps[j]);
+    print_excess(fx, clamps, ex);
     for (int k = 0; k < KINDS; k++) {
         out->median_deg[k] = median(ang[k], na[k]);
         print_message("  %-9s direction: median %5.2f deg, worst %5.2f deg (frame %zu)\n", KIND_NAME[k],
@@ -236,6 +293,10 @@ static void measure(const fixture *fx, const body_case *bc, body_stats *out)
     free(rp);
     free(q);
     free(clamps);
+    for (size_t j = 0; j < nr; j++)
+        for (int a = 0; a < 6; a++)
+            free(ex[j][a / 2][a % 2].deg);
+    free(ex);
     pb_retarget_free(rt);
     pb_mapping_free(map);
     pb_clip_free(clip);
@@ -255,13 +316,10 @@ static void run_case(const fixture *fx, const body_case *bc)
             fail_msg("%s frame %zu: the %s points %.1f deg away from the clip's", bc->clip, s.max_frame[k],
                      KIND_NAME[k], s.max_deg[k]);
     }
-    /* Issue 10 asks for fewer than 5% of frames clamped; what clamps now are
-     * the clips' own excursions past the rig's clinical (AAOS) ranges, from
-     * their mean posture: 131_01's right hand deviates radially past 20
-     * degrees in a quarter of its frames, 01_01's ankles dorsiflex past 20
-     * degrees on landing (6-10%) and its head turns past the atlanto-occipital
-     * range once the neck's is used up (5%). Held here so that they do not
-     * grow. */
+    /* Issue 10 asks for fewer than 5% of frames clamped. Under the rig's
+     * AAOS ranges 01_01's ankles dorsiflexed past 20 degrees on landing
+     * (6-10% of frames) and its head turned past the neck and head joints'
+     * 60 (5%): the maps widen those to physiological maxima. */
     if (s.clamped_frames > bc->max_clamped)
         fail_msg("%s: %.1f%% of the frames clamp a joint (at most %.0f%% expected)", bc->clip,
                  100.0 * s.clamped_frames, 100.0 * bc->max_clamped);
@@ -271,12 +329,63 @@ static void test_walk_131(void **state) { run_case(*state, &CASES[0]); }
 static void test_jumps_01(void **state) { run_case(*state, &CASES[1]); }
 static void test_jumps_01_asf_amc(void **state) { run_case(*state, &CASES[2]); }
 
+/* joint's state range, angle a: [lo, hi] */
+static void assert_state_range(const pose_state *st, const pose_rig *rig, const char *joint, int a, float lo,
+                               float hi)
+{
+    float min[3], max[3];
+    assert_int_equal(pose_get_joint_range(st, pose_rig_find_joint(rig, joint), min, max, NULL), POSE_OK);
+    if (min[a] != lo || max[a] != hi)
+        fail_msg("%s %s range [%g, %g], expected [%g, %g]", joint, ANGLE[a], (double)min[a], (double)max[a],
+                 (double)lo, (double)hi);
+}
+
+/* What a host gets from pose/bridge.h: every state the bridge poses has the
+ * map's ranges (a second state too), the angles and joints the map does not
+ * list keep the rig's; a range for a joint the rig cannot take fails the
+ * open, naming the map and the joint. */
+static void test_api_ranges(void **state)
+{
+    const fixture *fx = *state;
+    char clip[1024], map[1024];
+    BT_DATA(clip, "mocap/cmu-bvh/01_01.bvh");
+    BT_MAP(map, "cmu_cgspeed_bvh_to_full_body.json");
+    pose_bridge_options o = {.size = sizeof o, .map_path = map, .play = POSE_BRIDGE_MANUAL};
+    pose_bridge *b;
+    if (pose_bridge_open(clip, fx->rig, &o, &b) != POSE_OK)
+        fail_msg("%s", pose_last_error());
+    pose_state *st;
+    for (int k = 0; k < 2; k++) {
+        assert_int_equal(pose_state_create(fx->rig, &st), POSE_OK);
+        assert_state_range(st, fx->rig, "ankle_r", 0, -50, 20); /* the rig's AAOS range */
+        assert_true(pose_bridge_pose_at(b, 1.0 + k, st, NULL) >= 0);
+        assert_state_range(st, fx->rig, "ankle_r", 0, -50, 35);
+        assert_state_range(st, fx->rig, "ankle_l", 0, -50, 35);
+        assert_state_range(st, fx->rig, "ankle_r", 1, -15, 35);
+        assert_state_range(st, fx->rig, "wrist_r", 1, -40, 20);
+        assert_state_range(st, fx->rig, "head", 2, -45, 45);
+        assert_state_range(st, fx->rig, "head", 0, -15, 15);
+        assert_state_range(st, fx->rig, "knee_r", 0, 0, 135);
+        pose_state_free(st);
+    }
+    pose_bridge_close(b);
+
+    o.map_path = NULL;
+    o.map_json = "{\"ranges\": {\"pelvis\": {\"flexion\": [-10, 10]}}}";
+    b = (pose_bridge *)1;
+    assert_int_equal(pose_bridge_open(clip, fx->rig, &o, &b), POSE_ERR_UNSUPPORTED);
+    assert_null(b);
+    assert_non_null(
+        strstr(pose_last_error(), "map_json: ranges.pelvis: the rig has no clinical data for joint pelvis"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_walk_131),
         cmocka_unit_test(test_jumps_01),
         cmocka_unit_test(test_jumps_01_asf_amc),
+        cmocka_unit_test(test_api_ranges),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

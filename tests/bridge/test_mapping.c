@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0
  * Mapping files: invalid input first (syntax, fields, unknown joints and
  * channels), then the scalar-channel stages (calibration, inversion,
- * deadband, limits, Euler composition) with hand-computed values. */
+ * deadband, limits, Euler composition) with hand-computed values, and the
+ * ranges of motion a map gives the state it drives. */
 #include "bridge_test.h"
 #include "mapping.h"
 #include "pb_math.h"
@@ -48,6 +49,18 @@ static void test_bad_mapping_files(void **state)
     expect_parse_error("{\"channels\": [{\"channel\": \"a\", \"joint\": \"j\", \"axis\": \"x\", \"order\": \"XXY\"}]}",
                        "channels[0].order: expected");
     expect_parse_error("{\"joints\": {\"a\": \"b\", \"a\": \"c\"}}", "joints.a: rig joint mapped twice");
+    expect_parse_error("{\"ranges\": [1]}", "m.json: ranges: expected an object {rig joint: {angle: [min, max]}}");
+    expect_parse_error("{\"ranges\": {\"ankle_r\": [-50, 35]}}",
+                       "m.json: ranges.ankle_r: expected an object of 1 to 3 angles");
+    expect_parse_error("{\"ranges\": {\"ankle_r\": {}}}", "m.json: ranges.ankle_r: expected an object of 1 to 3 angles");
+    expect_parse_error("{\"ranges\": {\"ankle_r\": {\"a\": [0, 1], \"b\": [0, 1], \"c\": [0, 1], \"d\": [0, 1]}}}",
+                       "ranges.ankle_r: expected an object of 1 to 3 angles");
+    expect_parse_error("{\"ranges\": {\"ankle_r\": {\"flexion\": [-50]}}}",
+                       "m.json: ranges.ankle_r.flexion: expected [number, number]");
+    expect_parse_error("{\"ranges\": {\"ankle_r\": {\"flexion\": [35, -50]}}}",
+                       "m.json: ranges.ankle_r.flexion: min 35 is above max -50");
+    expect_parse_error("{\"ranges\": {\"ankle_r\": {\"flexion\": [0, 1]}, \"ankle_r\": {\"flexion\": [0, 2]}}}",
+                       "m.json: ranges.ankle_r: joint given twice");
     pb_mapping *m;
     pb_error err;
     assert_int_equal(pb_mapping_load("/nonexistent/map.json", &m, &err), POSE_ERR_IO);
@@ -172,6 +185,9 @@ static void test_shipped_maps_parse(void **state)
     (void)state;
     const char *maps[] = {"cmu131_bvh_to_full_body.json", "cmu_cgspeed_bvh_to_full_body.json",
                           "cmu_asf_to_full_body.json", "cmu131_arm_to_bar.json"};
+    pb_rig_skel *body;
+    pb_error body_err;
+    assert_int_equal(pb_rig_skel_schematic_body(&body, &body_err), POSE_OK);
     for (size_t i = 0; i < sizeof maps / sizeof maps[0]; i++) {
         char p[1024];
         bt_path(p, sizeof p, "POSE_DATA_DIR", "../bridge/maps/");
@@ -181,8 +197,16 @@ static void test_shipped_maps_parse(void **state)
         if (pb_mapping_load(p, &m, &err) != POSE_OK)
             fail_msg("%s", err.message);
         assert_true(m->joint_count >= 4);
+        /* the mocap maps' ranges bind to any body with the template's joints */
+        for (int k = 0; k < m->range_count; k++) {
+            pb_joint_range r;
+            if (pb_mapping_resolve_range(m, k, body, &r, &err) != POSE_OK)
+                fail_msg("%s", err.message);
+        }
+        assert_int_equal(m->range_count, strstr(maps[i], "full_body") ? 5 : 0);
         pb_mapping_free(m);
     }
+    pb_rig_skel_free(body);
 }
 
 /* Clinical entries ("dof"): bound to the rig's clinical angles by generic or
@@ -273,6 +297,108 @@ static void test_clinical_channels(void **state)
     pose_rig_free(prig);
 }
 
+/* A rig whose root has no clinical data and whose ankle carries the
+ * template's names and AAOS ranges. */
+static pose_rig *ankle_rig(void)
+{
+    pose_joint_desc jd[2] = {{.name = "root", .parent = -1, .rest_model = {{0, 0, 0, 1}, {0, 0, 0}}},
+                             {.name = "ankle", .parent = 0, .rest_model = {{0, 0, 0, 1}, {0, 0, -1}}}};
+    pose_joint_clinical cl[2] = {{.flags = 0},
+                                 {.neutral = {0, 0, 0, 1},
+                                  .axes = {{0, -1, 0}, {1, 0, 0}, {0, 0, -1}},
+                                  .names = {"dorsiflexion", "inversion", "internal_rotation"},
+                                  .limit_flags = POSE_LIMIT_X | POSE_LIMIT_Y | POSE_LIMIT_Z,
+                                  .limit_min_deg = {-50, -15, -25},
+                                  .limit_max_deg = {20, 35, 25},
+                                  .flags = POSE_CLINICAL_DEFINED}};
+    const float tet_p[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const uint32_t tet[4] = {0, 1, 2, 3};
+    const uint16_t lab[1] = {0}, wj[4] = {0, 0, 0, 0};
+    const float w[4] = {1, 1, 1, 1};
+    pose_rig_desc d = {.joint_count = 2, .joints = jd, .tet_vertex_count = 4, .tet_positions = tet_p,
+                       .tet_count = 1, .tets = tet, .tet_labels = lab, .influences = 1, .weight_joints = wj,
+                       .weights = w, .clinical = cl};
+    pose_rig *rig;
+    if (pose_rig_create(&d, NULL, &rig) != POSE_OK)
+        fail_msg("%s", pose_last_error());
+    return rig;
+}
+
+/* "ranges": bound by generic or the joint's own angle names, the rest of
+ * the joint keeping the rig's range; put on a state, which then lets through
+ * what the rig's range clamps; refused, naming the map and key, for unknown
+ * joints and angles, an angle given twice, and a joint without clinical data. */
+static void test_ranges(void **state)
+{
+    (void)state;
+    pose_rig *prig = ankle_rig();
+    pb_rig_skel *rig;
+    pb_error err;
+    assert_int_equal(pb_rig_skel_from_rig(prig, &rig, &err), POSE_OK);
+    const char *js = "{\"ranges\": {\"ankle\": {\"dorsiflexion\": [-50, 35], \"rotation\": [-30, 30]}}}";
+    pb_mapping *m;
+    assert_int_equal(pb_mapping_parse(js, strlen(js), "m.json", &m, &err), POSE_OK);
+    assert_int_equal(m->range_count, 1);
+    pb_joint_range r;
+    assert_int_equal(pb_mapping_resolve_range(m, 0, rig, &r, &err), POSE_OK);
+    assert_int_equal(r.joint, 1);
+    const float lo[3] = {-50, -15, -30}, hi[3] = {35, 35, 30};
+    for (int a = 0; a < 3; a++) {
+        assert_true(r.min_deg[a] == lo[a]);
+        assert_true(r.max_deg[a] == hi[a]);
+    }
+
+    pose_state *st, *plain;
+    assert_int_equal(pose_state_create(prig, &st), POSE_OK);
+    assert_int_equal(pose_state_create(prig, &plain), POSE_OK);
+    assert_int_equal(pb_mapping_apply_ranges(m, rig, st, &err), POSE_OK);
+    float got_lo[3], got_hi[3];
+    uint32_t flags;
+    assert_int_equal(pose_get_joint_range(st, 1, got_lo, got_hi, &flags), POSE_OK);
+    assert_memory_equal(got_lo, lo, sizeof lo);
+    assert_memory_equal(got_hi, hi, sizeof hi);
+    assert_int_equal(flags, POSE_LIMIT_X | POSE_LIMIT_Y | POSE_LIMIT_Z);
+    const float landing[3] = {30, 0, -28};
+    assert_int_equal(pose_set_joint_clinical(st, 1, landing), POSE_OK);
+    assert_int_equal(pose_set_joint_clinical(plain, 1, landing), POSE_CLAMPED);
+    assert_non_null(strstr(pose_last_error(), "dorsiflexion 30.00 clamped to 20.00"));
+    /* once there, applying again changes nothing */
+    assert_int_equal(pb_joint_range_apply(&r, st), POSE_OK);
+    float deg[3];
+    assert_int_equal(pose_get_joint_clinical(st, 1, deg), POSE_OK);
+    assert_true(deg[0] == 30.0f && deg[2] == -28.0f);
+    pose_state_free(plain);
+    pose_state_free(st);
+    pb_mapping_free(m);
+
+    const char *bad[4] = {"{\"ranges\": {\"knee\": {\"flexion\": [0, 150]}}}",
+                          "{\"ranges\": {\"root\": {\"flexion\": [-10, 10]}}}",
+                          "{\"ranges\": {\"ankle\": {\"pronation\": [-10, 10]}}}",
+                          "{\"ranges\": {\"ankle\": {\"flexion\": [-50, 35], \"dorsiflexion\": [-50, 30]}}}"};
+    const pose_status want_status[4] = {POSE_ERR_NOT_FOUND, POSE_ERR_UNSUPPORTED, POSE_ERR_NOT_FOUND,
+                                        POSE_ERR_FORMAT};
+    const char *want_msg[4] = {
+        "m.json: ranges.knee: the rig has no joint 'knee'",
+        "m.json: ranges.root: the rig has no clinical data for joint root, so no range of motion in clinical "
+        "angles to replace",
+        "m.json: ranges.ankle.pronation: joint ankle has no angle 'pronation' (it has dorsiflexion, inversion, "
+        "internal_rotation)",
+        "m.json: ranges.ankle.dorsiflexion: the joint's dorsiflexion range is given twice"};
+    assert_int_equal(pose_state_create(prig, &st), POSE_OK);
+    for (int i = 0; i < 4; i++) {
+        assert_int_equal(pb_mapping_parse(bad[i], strlen(bad[i]), "m.json", &m, &err), POSE_OK);
+        assert_int_equal(pb_mapping_resolve_range(m, 0, rig, &r, &err), want_status[i]);
+        assert_string_equal(err.message, want_msg[i]);
+        err.message[0] = '\0';
+        assert_int_equal(pb_mapping_apply_ranges(m, rig, st, &err), want_status[i]);
+        assert_string_equal(err.message, want_msg[i]);
+        pb_mapping_free(m);
+    }
+    pose_state_free(st);
+    pb_rig_skel_free(rig);
+    pose_rig_free(prig);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -281,6 +407,7 @@ int main(void)
         cmocka_unit_test(test_channel_stages),
         cmocka_unit_test(test_clinical_channels),
         cmocka_unit_test(test_shipped_maps_parse),
+        cmocka_unit_test(test_ranges),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -2,8 +2,9 @@
 /* Clinical angles on a small arm rig that rests in a T-pose and whose
  * clinical data puts the arm down at neutral: postures measured back from
  * pose_joint_world, conversions both ways (both triples, hints, gimbal
- * lock), clamping in the clinical range of motion from every setter, the
- * neutral posture, and rigs without clinical data. */
+ * lock), clamping in the clinical range of motion from every setter, a
+ * state's own ranges (pose_set_joint_range), the neutral posture, and rigs
+ * without clinical data. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -400,6 +401,151 @@ static void test_clamping(void **unused)
     pose_rig_free(rig);
 }
 
+static void assert_range(const pose_state *st, int joint, const float lo[3], const float hi[3],
+                         uint32_t flags)
+{
+    float got_lo[3], got_hi[3];
+    uint32_t got_flags = 0;
+    assert_int_equal(pose_get_joint_range(st, joint, got_lo, got_hi, &got_flags), POSE_OK);
+    for (int a = 0; a < 3; a++) {
+        assert_true(got_lo[a] == lo[a]);
+        assert_true(got_hi[a] == hi[a]);
+    }
+    assert_int_equal(got_flags, flags);
+}
+
+/* A frozen shoulder narrows one state's range: requests the rig's range
+ * allows clamp there, from every setter, while another state of the same
+ * rig is untouched; NULL gives the rig's range back. */
+static void test_narrowed_range(void **unused)
+{
+    (void)unused;
+    pose_rig *rig = arm_rig(1);
+    pose_state *st, *other;
+    assert_int_equal(pose_state_create(rig, &st), POSE_OK);
+    assert_int_equal(pose_state_create(rig, &other), POSE_OK);
+    const float rig_lo[3] = {-60, -30, -90}, rig_hi[3] = {180, 180, 70};
+    const uint32_t xyz = POSE_LIMIT_X | POSE_LIMIT_Y | POSE_LIMIT_Z;
+    assert_range(st, SHOULDER, rig_lo, rig_hi, xyz);
+
+    set_clinical(st, SHOULDER, 90, 0, 0, POSE_OK);
+    const float lo[3] = {-10, -10, -20}, hi[3] = {40, 45, 20};
+    assert_int_equal(pose_set_joint_range(st, SHOULDER, lo, hi), POSE_OK);
+    assert_range(st, SHOULDER, lo, hi, xyz);
+    float deg[3];
+    pose_get_joint_clinical(st, SHOULDER, deg); /* kept until the joint is set again */
+    assert_angles(deg, 90, 0, 0, 1e-4);
+
+    set_clinical(st, SHOULDER, 90, 0, 0, POSE_CLAMPED);
+    assert_message("joint 1 'shoulder_l': flexion 90.00 clamped to 40.00 by 50.00 [-10.00, 40.00]");
+    assert_local_is(st, SHOULDER, 40, 0, 0);
+    set_clinical(other, SHOULDER, 90, 0, 0, POSE_OK);
+    /* A quaternion: abduction 150 stops at 45, where the arm then points. */
+    const float raised[3] = {0, 150, 0};
+    float q[4];
+    pose_clinical_to_local(rig, SHOULDER, raised, q);
+    assert_int_equal(pose_set_joint(st, SHOULDER, q), POSE_CLAMPED);
+    assert_message("abduction 150.00 clamped to 45.00 by 105.00");
+    assert_local_is(st, SHOULDER, 0, 45, 0);
+    assert_int_equal(pose_apply(st), POSE_OK);
+    assert_segment(st, SHOULDER, ELBOW, UPPER_ARM, S45, -S45, 0);
+    assert_int_equal(pose_set_joint(other, SHOULDER, q), POSE_OK);
+
+    /* pose_reset keeps the state's range; NULL restores the rig's. */
+    assert_int_equal(pose_reset(st), POSE_OK);
+    assert_range(st, SHOULDER, lo, hi, xyz);
+    assert_int_equal(pose_set_joint_range(st, SHOULDER, NULL, NULL), POSE_OK);
+    assert_range(st, SHOULDER, rig_lo, rig_hi, xyz);
+    set_clinical(st, SHOULDER, 90, 0, 0, POSE_OK);
+    assert_int_equal(pose_set_joint(st, SHOULDER, q), POSE_OK);
+    pose_state_free(other);
+    pose_state_free(st);
+    pose_rig_free(rig);
+}
+
+/* A wider range lets through what the rig's clamps; an angle the rig leaves
+ * free can be limited, and a whole turn frees it again; a contracture that
+ * excludes 0 makes the neutral posture clamp. */
+static void test_widened_range(void **unused)
+{
+    (void)unused;
+    pose_rig *rig = arm_rig(1);
+    pose_state *st;
+    assert_int_equal(pose_state_create(rig, &st), POSE_OK);
+    const float rig_lo[3] = {0, -180, -80}, rig_hi[3] = {150, 180, 80};
+    assert_range(st, ELBOW, rig_lo, rig_hi, POSE_LIMIT_X | POSE_LIMIT_Z);
+    set_clinical(st, ELBOW, 160, 0, 0, POSE_CLAMPED);
+
+    const float lo[3] = {-5, -5, -90}, hi[3] = {165, 5, 90};
+    assert_int_equal(pose_set_joint_range(st, ELBOW, lo, hi), POSE_OK);
+    assert_range(st, ELBOW, lo, hi, POSE_LIMIT_X | POSE_LIMIT_Y | POSE_LIMIT_Z);
+    set_clinical(st, ELBOW, 160, 0, -85, POSE_OK);
+    assert_local_is(st, ELBOW, 160, 0, -85);
+    set_clinical(st, ELBOW, -3, 0, 0, POSE_OK); /* hyperextension */
+    set_clinical(st, ELBOW, 45, 20, 0, POSE_CLAMPED); /* varus, free on the rig, now limited */
+    assert_message("joint 2 'elbow_l': varus 20.00 clamped to 5.00 by 15.00 [-5.00, 5.00]");
+    assert_local_is(st, ELBOW, 45, 5, 0);
+
+    const float free_lo[3] = {-5, -180, -90}, free_hi[3] = {165, 180, 90};
+    assert_int_equal(pose_set_joint_range(st, ELBOW, free_lo, free_hi), POSE_OK);
+    assert_range(st, ELBOW, free_lo, free_hi, POSE_LIMIT_X | POSE_LIMIT_Z);
+    set_clinical(st, ELBOW, 45, 20, 0, POSE_OK);
+
+    const float contracture_lo[3] = {20, -180, -80}, contracture_hi[3] = {90, 180, 80};
+    assert_int_equal(pose_set_joint_range(st, ELBOW, contracture_lo, contracture_hi), POSE_OK);
+    assert_int_equal(pose_set_neutral(st), POSE_CLAMPED);
+    assert_message("joint 2 'elbow_l': flexion 0.00 clamped to 20.00");
+    float deg[3];
+    pose_get_joint_clinical(st, ELBOW, deg);
+    assert_angles(deg, 20, 0, 0, 1e-4);
+    pose_state_free(st);
+    pose_rig_free(rig);
+}
+
+static void test_range_arguments(void **unused)
+{
+    (void)unused;
+    pose_rig *rig = arm_rig(1);
+    pose_state *st;
+    assert_int_equal(pose_state_create(rig, &st), POSE_OK);
+    const float lo[3] = {0, 0, 0}, hi[3] = {10, 10, 10}, bad_hi[3] = {10, -1, 10};
+    const float nan3[3] = {0, NAN, 0}, inf3[3] = {10, 10, INFINITY};
+    float out[3];
+    uint32_t flags;
+    assert_int_equal(pose_set_joint_range(NULL, SHOULDER, lo, hi), POSE_ERR_INVALID_ARGUMENT);
+    assert_int_equal(pose_set_joint_range(st, -1, lo, hi), POSE_ERR_INVALID_ARGUMENT);
+    assert_int_equal(pose_set_joint_range(st, JOINTS, lo, hi), POSE_ERR_INVALID_ARGUMENT);
+    assert_message("joint 4 out of range (4 joints)");
+    assert_int_equal(pose_set_joint_range(st, WRIST, lo, hi), POSE_ERR_UNSUPPORTED);
+    assert_message("pose_set_joint_range: joint 3 'wrist_l' has no clinical data");
+    assert_int_equal(pose_set_joint_range(st, WRIST, NULL, NULL), POSE_ERR_UNSUPPORTED);
+    assert_int_equal(pose_set_joint_range(st, SHOULDER, lo, NULL), POSE_ERR_INVALID_ARGUMENT);
+    assert_int_equal(pose_set_joint_range(st, SHOULDER, NULL, hi), POSE_ERR_INVALID_ARGUMENT);
+    assert_message("give both min_deg and max_deg");
+    assert_int_equal(pose_set_joint_range(st, SHOULDER, lo, bad_hi), POSE_ERR_INVALID_ARGUMENT);
+    assert_message("joint 1 'shoulder_l': abduction range [0, -1] is not finite with min <= max");
+    assert_int_equal(pose_set_joint_range(st, SHOULDER, nan3, hi), POSE_ERR_INVALID_ARGUMENT);
+    assert_int_equal(pose_set_joint_range(st, ELBOW, lo, inf3), POSE_ERR_INVALID_ARGUMENT);
+    assert_message("pronation range [0, inf]");
+    /* a refused range leaves the state's as it was */
+    const float rig_lo[3] = {-60, -30, -90}, rig_hi[3] = {180, 180, 70};
+    assert_range(st, SHOULDER, rig_lo, rig_hi, POSE_LIMIT_X | POSE_LIMIT_Y | POSE_LIMIT_Z);
+    assert_int_equal(pose_get_joint_range(NULL, SHOULDER, out, out, &flags), POSE_ERR_INVALID_ARGUMENT);
+    assert_int_equal(pose_get_joint_range(st, 9, out, out, &flags), POSE_ERR_INVALID_ARGUMENT);
+    assert_int_equal(pose_get_joint_range(st, SPINE, out, out, &flags), POSE_ERR_UNSUPPORTED);
+    assert_int_equal(pose_get_joint_range(st, SHOULDER, NULL, NULL, NULL), POSE_OK);
+    pose_state_free(st);
+    pose_rig_free(rig);
+
+    /* a rig without clinical data has no ranges to give */
+    rig = arm_rig(0);
+    assert_int_equal(pose_state_create(rig, &st), POSE_OK);
+    assert_int_equal(pose_set_joint_range(st, SHOULDER, lo, hi), POSE_ERR_UNSUPPORTED);
+    assert_int_equal(pose_get_joint_range(st, SHOULDER, out, out, &flags), POSE_ERR_UNSUPPORTED);
+    pose_state_free(st);
+    pose_rig_free(rig);
+}
+
 static void test_set_neutral(void **unused)
 {
     (void)unused;
@@ -497,6 +643,9 @@ int main(void)
         cmocka_unit_test(test_round_trip),
         cmocka_unit_test(test_gimbal_lock),
         cmocka_unit_test(test_clamping),
+        cmocka_unit_test(test_narrowed_range),
+        cmocka_unit_test(test_widened_range),
+        cmocka_unit_test(test_range_arguments),
         cmocka_unit_test(test_set_neutral),
         cmocka_unit_test(test_without_clinical_data),
         cmocka_unit_test(test_invalid_arguments),

@@ -187,9 +187,11 @@ POSE_BRIDGE_API void pose_bridge_close(pose_bridge *bridge);
  * Apply the newest pose to `state` (a state of the bridge's rig): never
  * blocks, allocates nothing. Joints the mapping drives are set (every call,
  * fresh or not); the others are left as they are; nothing is set before the
- * first pose. `frame` may be NULL. POSE_CLAMPED when a limit changed a
- * joint. In POSE_BRIDGE_MANUAL it sets nothing and reports the last
- * pose_bridge_pose_at. @since 0.2
+ * first pose. The mapping's "ranges" become the state's ranges of motion for
+ * the joints they list (pose_set_joint_range), here and in
+ * pose_bridge_pose_at. `frame` may be NULL. POSE_CLAMPED when a limit
+ * changed a joint. In POSE_BRIDGE_MANUAL it sets nothing and reports the
+ * last pose_bridge_pose_at. @since 0.2
  */
 POSE_BRIDGE_API pose_status pose_bridge_apply(pose_bridge *bridge, pose_state *state, pose_bridge_frame *frame);
 /**

@@ -115,6 +115,23 @@ static pb_runner_options runner_options(const pose_bridge *b)
     };
 }
 
+/* The map's "ranges" against the rig, now: a joint the rig cannot take a
+ * range for fails the open, not the first frame. */
+static pose_status bind_ranges(pose_bridge *b, pb_error *err)
+{
+    if (b->map->range_count == 0)
+        return POSE_OK;
+    b->ranges = pb_bridge_alloc(b, (size_t)b->map->range_count * sizeof *b->ranges);
+    if (!b->ranges)
+        return pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "pose_bridge_open: out of memory");
+    for (; b->range_count < b->map->range_count; b->range_count++) {
+        pose_status s = pb_mapping_resolve_range(b->map, b->range_count, b->skel, &b->ranges[b->range_count], err);
+        if (s < 0)
+            return s;
+    }
+    return POSE_OK;
+}
+
 static pose_status open_parts(pose_bridge *b, pb_error *err)
 {
     pose_status s = pb_spec_parse(b->source, &b->spec, err);
@@ -138,6 +155,8 @@ static pose_status open_parts(pose_bridge *b, pb_error *err)
     else
         s = pb_mapping_identity(&b->map, err);
     if (s < 0)
+        return s;
+    if ((s = bind_ranges(b, err)) < 0)
         return s;
     if (clip && (s = load_clip(b, err)) < 0)
         return s;
@@ -229,6 +248,7 @@ void pose_bridge_close(pose_bridge *b)
     pb_scrub_close(b);
     pb_clip_free(b->clip);
     pb_mapping_free(b->map);
+    pb_bridge_free(b, b->ranges);
     pb_rig_skel_free(b->skel);
     pb_bridge_free(b, b->source);
     pb_bridge_free(b, b->map_path);
@@ -239,8 +259,16 @@ void pose_bridge_close(pose_bridge *b)
 
 /* ------------------------------------------------------------------ poses */
 
-static pose_status set_state(const pb_pose *p, pose_state *st, pose_bridge_frame *f)
+static pose_status set_state(const pose_bridge *b, const pb_pose *p, pose_state *st, pose_bridge_frame *f)
 {
+    /* Every call rather than once per state: a host's next state may sit
+     * where its last one was freed. A state that has them already costs a
+     * read per range. */
+    for (int i = 0; i < b->range_count; i++) {
+        pose_status s = pb_joint_range_apply(&b->ranges[i], st);
+        if (s < 0)
+            return s;
+    }
     int clamped = 0;
     pose_status s = pb_pose_apply_to_state(p, st, &clamped);
     if (s < 0)
@@ -282,7 +310,7 @@ pose_status pose_bridge_apply(pose_bridge *b, pose_state *st, pose_bridge_frame 
         const pb_pose *p = pb_runner_latest(b->runner, &fresh);
         f.held = pb_state_holds(pb_runner_source_state(b->runner));
         if (p->seq > 0) {
-            s = set_state(p, st, &f);
+            s = set_state(b, p, st, &f);
             if (s < 0)
                 return s;
             f.fresh = fresh;
@@ -314,7 +342,7 @@ pose_status pose_bridge_pose_at(pose_bridge *b, double t_s, pose_state *st, pose
     if (s < 0)
         return fail(s, err.message);
     pose_bridge_frame f = {.fresh = 1, .held = b->scrub.held, .seq = b->manual.seq + 1};
-    s = set_state(&b->scrub.pose, st, &f);
+    s = set_state(b, &b->scrub.pose, st, &f);
     if (s < 0)
         return s;
     f.age_s = t_s - b->scrub.media_s;

@@ -52,6 +52,8 @@ struct pose_bridge {
     const pose_rig *rig;
     pb_rig_skel *skel;
     pb_mapping *map;
+    pb_joint_range *ranges; /**< the map's "ranges", bound to the rig: put on every state posed */
+    int range_count;
     pb_clip *clip;
     double period;         /**< clips: media seconds between ticks */
     double duration_s;     /**< recordings: length; < 0 until measured (live: never) */

@@ -38,6 +38,18 @@
  *       posture (CMU's straight spine and mid-chest collars): the segment
  *       then keeps the rig's rest posture at the clip's reference pose.
  *   "filter": default One Euro parameters for every joint / channel.
+ *   "ranges": { "<rig joint>": { "flexion": [min_deg, max_deg],
+ *       "abduction": [...], "rotation": [...] }, ... }: the range of motion
+ *       the state the bridge drives clamps each listed joint to, in clinical
+ *       angles (degrees from neutral; the keys are the generic names or the
+ *       joint's own names for its angles, "dorsiflexion", "radial_deviation"
+ *       ...), in place of the rig's (AAOS normal ranges on a baked body):
+ *       recorded people exceed the normals; devices keep them. Angles not
+ *       given keep the rig's range. Resolved when bound to a rig: an unknown
+ *       joint or angle, or a joint without clinical data, is an error naming
+ *       the file and key. pose_bridge_apply / pose_bridge_pose_at put them on
+ *       every state they pose (pose_set_joint_range); tests and tools call
+ *       pb_mapping_apply_ranges.
  * Without "joints" and "channels", clip joints drive rig joints of the same
  * name (pb_mapping_identity).
  */
@@ -83,6 +95,14 @@ typedef struct pb_map_channel {
     double limit[2];
 } pb_map_channel;
 
+/** A "ranges" entry as written (angle names resolved by pb_mapping_resolve_range). */
+typedef struct pb_map_range {
+    char joint[PB_NAME_MAX];
+    int angle_count;           /**< 1..3 */
+    char angle[3][32];         /**< per key: "flexion", "abduction", "rotation" or the rig's name */
+    double min_deg[3], max_deg[3];
+} pb_map_range;
+
 typedef struct pb_mapping {
     char path[256];
     double axes_q[4];          /**< source frame -> rig frame */
@@ -98,6 +118,8 @@ typedef struct pb_mapping {
     pb_map_joint *joints;
     int channel_count;
     pb_map_channel *channels;
+    int range_count;
+    pb_map_range *ranges;
 } pb_mapping;
 
 pose_status pb_mapping_parse(const char *json, size_t size, const char *name, pb_mapping **out, pb_error *err);
@@ -105,6 +127,25 @@ pose_status pb_mapping_load(const char *path, pb_mapping **out, pb_error *err);
 /** A mapping that drives rig joints from clip joints of the same name. */
 pose_status pb_mapping_identity(pb_mapping **out, pb_error *err);
 void pb_mapping_free(pb_mapping *m);
+
+/* ---------------------------------------------------------------- ranges */
+
+/** A "ranges" entry bound to a rig: all three angles, the rig's where the
+ *  map gives none (an unlimited angle: [-180, 180]). */
+typedef struct pb_joint_range {
+    int joint;
+    float min_deg[3], max_deg[3];
+} pb_joint_range;
+
+/** Bind map->ranges[entry] to `rig`. Errors name the map and the key. */
+pose_status pb_mapping_resolve_range(const pb_mapping *map, int entry, const pb_rig_skel *rig,
+                                     pb_joint_range *out, pb_error *err);
+/** Put every "ranges" entry on `state` (a state of the rig `rig` describes). Allocates nothing. */
+pose_status pb_mapping_apply_ranges(const pb_mapping *map, const pb_rig_skel *rig, pose_state *state,
+                                    pb_error *err);
+/** Give `state` the bound range unless it has it already (one read per call
+ *  otherwise: cheap enough for every frame). Allocates nothing. */
+pose_status pb_joint_range_apply(const pb_joint_range *r, pose_state *state);
 
 /* ------------------------------------------------------------ retargeting */
 

@@ -30,6 +30,7 @@ void pb_mapping_free(pb_mapping *m)
         return;
     free(m->joints);
     free(m->channels);
+    free(m->ranges);
     free(m);
 }
 
@@ -218,6 +219,59 @@ static pose_status parse_pair(const cJSON *v, double out[2], const char *path, c
     return POSE_OK;
 }
 
+/* "ranges": {"<rig joint>": {"<angle>": [min, max], ...}, ...}; the angle
+ * names are resolved against the rig when bound (mapping_ranges.c). */
+static pose_status parse_ranges(pb_mapping *m, const cJSON *o, pb_error *err)
+{
+    if (!cJSON_IsObject(o))
+        return pb_fail(err, POSE_ERR_FORMAT, "%s: ranges: expected an object {rig joint: {angle: [min, max]}}",
+                       m->path);
+    int n = cJSON_GetArraySize(o);
+    if (n > MAP_MAX_ENTRIES)
+        return pb_fail(err, POSE_ERR_FORMAT, "%s: ranges: more than %d entries", m->path, MAP_MAX_ENTRIES);
+    m->ranges = calloc(n > 0 ? (size_t)n : 1, sizeof *m->ranges);
+    if (!m->ranges)
+        return pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+    const cJSON *e;
+    cJSON_ArrayForEach(e, o)
+    {
+        pb_map_range *R = &m->ranges[m->range_count];
+        if (!e->string || strlen(e->string) == 0 || strlen(e->string) >= PB_NAME_MAX)
+            return pb_fail(err, POSE_ERR_FORMAT, "%s: ranges: rig joint names must have 1..%d bytes", m->path,
+                           PB_NAME_MAX - 1);
+        memcpy(R->joint, e->string, strlen(e->string) + 1);
+        for (int k = 0; k < m->range_count; k++)
+            if (strcmp(m->ranges[k].joint, R->joint) == 0)
+                return pb_fail(err, POSE_ERR_FORMAT, "%s: ranges.%s: joint given twice", m->path, R->joint);
+        if (!cJSON_IsObject(e) || cJSON_GetArraySize(e) < 1 || cJSON_GetArraySize(e) > 3)
+            return pb_fail(err, POSE_ERR_FORMAT,
+                           "%s: ranges.%s: expected an object of 1 to 3 angles {\"flexion\": [min, max], ...}",
+                           m->path, R->joint);
+        const cJSON *a;
+        cJSON_ArrayForEach(a, e)
+        {
+            int k = R->angle_count;
+            char where[PB_NAME_MAX + 48];
+            if (!a->string || strlen(a->string) == 0 || strlen(a->string) >= sizeof R->angle[k])
+                return pb_fail(err, POSE_ERR_FORMAT, "%s: ranges.%s: angle names must have 1..%zu bytes", m->path,
+                               R->joint, sizeof R->angle[k] - 1);
+            memcpy(R->angle[k], a->string, strlen(a->string) + 1);
+            snprintf(where, sizeof where, "ranges.%s.%s", R->joint, R->angle[k]);
+            double v[2];
+            pose_status s = parse_pair(a, v, m->path, where, err);
+            if (s)
+                return s;
+            if (v[0] > v[1])
+                return pb_fail(err, POSE_ERR_FORMAT, "%s: %s: min %g is above max %g", m->path, where, v[0], v[1]);
+            R->min_deg[k] = v[0];
+            R->max_deg[k] = v[1];
+            R->angle_count++;
+        }
+        m->range_count++;
+    }
+    return POSE_OK;
+}
+
 static pose_status parse_channel(pb_mapping *m, const cJSON *e, int i, pb_error *err)
 {
     pb_map_channel *C = &m->channels[i];
@@ -397,6 +451,12 @@ static pose_status parse_root(pb_mapping *m, const cJSON *root, pb_error *err)
     const cJSON *joints = cJSON_GetObjectItemCaseSensitive(root, "joints");
     if (joints) {
         pose_status s = parse_joints(m, joints, err);
+        if (s)
+            return s;
+    }
+    const cJSON *ranges = cJSON_GetObjectItemCaseSensitive(root, "ranges");
+    if (ranges) {
+        pose_status s = parse_ranges(m, ranges, err);
         if (s)
             return s;
     }

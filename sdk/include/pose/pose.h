@@ -315,9 +315,10 @@ POSE_API uint32_t pose_rig_format_version(const pose_rig *rig);
  *
  * Rotations compose; angles are never added axis by axis. Where a rig carries
  * clinical data for a joint, that joint's limits are the clinical ones
- * (AAOS normal ranges of motion by default) and every way of setting it
- * (pose_set_joint, pose_set_joint_euler, pose_set_joint_clinical) is clamped
- * in the clinical convention.
+ * (AAOS normal ranges of motion by default; a state may have its own,
+ * pose_set_joint_range) and every way of setting it (pose_set_joint,
+ * pose_set_joint_euler, pose_set_joint_clinical) is clamped in the clinical
+ * convention.
  */
 typedef struct pose_joint_clinical {
     float neutral[4];      /**< local rotation (relative to rest) of the neutral posture */
@@ -486,6 +487,33 @@ POSE_API pose_status pose_get_joint_clinical(const pose_state *state, int joint,
 /** Every joint with clinical data to its neutral posture (the others to rest), root to identity.
  *  POSE_CLAMPED if a joint's range of motion excludes its neutral posture. @since 0.2 */
 POSE_API pose_status pose_set_neutral(pose_state *state);
+/**
+ * Give this state its own range of motion for `joint`, in clinical angles
+ * {flexion, abduction, rotation} (degrees from neutral, as
+ * pose_joint_clinical.limit_min_deg / limit_max_deg): a patient's frozen
+ * shoulder or contracture, or a recorded person's range past the rig's
+ * (normal ranges of motion are averages, and mocap of healthy people
+ * exceeds them). Every setter of the joint then clamps to it, as it did to
+ * the rig's; the joint's current rotation is kept until it is set again.
+ * An angle whose range spans a whole turn (max - min >= 360) is unlimited;
+ * every other angle is limited, including one the rig leaves free. Both
+ * pointers NULL restore the rig's range. POSE_ERR_INVALID_ARGUMENT when one
+ * is NULL, a value is not finite or min > max; POSE_ERR_UNSUPPORTED for a
+ * joint without clinical data. Allocates nothing; pose_reset keeps the
+ * state's ranges. pose_local_to_clinical and pose_rig_joint_clinical keep
+ * speaking of the rig's. @since 0.2
+ */
+POSE_API pose_status pose_set_joint_range(pose_state *state, int joint, const float min_deg[3],
+                                          const float max_deg[3]);
+/**
+ * The range of motion this state clamps `joint` to (pose_set_joint_range,
+ * else the rig's): any output pointer may be NULL; limit_flags gets
+ * POSE_LIMIT_X / _Y / _Z for limited flexion / abduction / rotation, and an
+ * unlimited angle reads [-180, 180] unless a range was set for it.
+ * POSE_ERR_UNSUPPORTED for a joint without clinical data. @since 0.2
+ */
+POSE_API pose_status pose_get_joint_range(const pose_state *state, int joint, float min_deg[3],
+                                          float max_deg[3], uint32_t *limit_flags);
 /** The joint's current local rotation (after clamping). @since 0.1 */
 POSE_API pose_status pose_get_joint(const pose_state *state, int joint, float quat_xyzw[4]);
 /**
