@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: Apache-2.0
+// A console host of Pose.cs, as a Unity script would use it: load a rig, take
+// a clip's pose at a time through the bridge, bend one joint, pose, and write
+// every tissue's positions (float32, tissue after tissue) so a test can
+// compare them with the C API's (tests/python/pose_positions.c does the same).
+//   mcs -out:sample.exe Pose.cs examples/Sample.cs && mono sample.exe RIG OUT [CLIP MAP TIME]
+using System;
+using System.IO;
+
+class Sample
+{
+    static int Main(string[] args)
+    {
+        if (args.Length != 2 && args.Length != 5) {
+            Console.Error.WriteLine("usage: sample.exe RIG OUT [CLIP MAP TIME]");
+            return 2;
+        }
+        try {
+            using (var rig = new Pose.Rig(args[0]))
+            using (var state = new Pose.State(rig, 0, Pose.Method.DQS)) {
+                if (args.Length == 5) {
+                    var options = new Pose.BridgeOptions { MapPath = args[3], Play = Pose.Play.Manual };
+                    using (var clip = new Pose.Bridge(args[2], rig, options)) {
+                        Pose.BridgeFrame f = clip.PoseAt(double.Parse(args[4], System.Globalization.CultureInfo.InvariantCulture), state);
+                        Console.WriteLine("{0}: {1} joints at {2:F3} s ({3})", args[2], f.Joints, f.MediaS,
+                                          clip.Status().Kind);
+                    }
+                }
+                int joint = rig.JointCount / 2;
+                bool clamped = state.SetJointEuler(joint, 10, 40, 0);
+                state.Apply();
+                using (var file = new BinaryWriter(File.Create(args[1]))) {
+                    for (int t = 0; t < rig.TissueCount; t++)
+                        foreach (float v in state.Positions(t))
+                            file.Write(v);
+                }
+                float[] lo = new float[3], hi = new float[3];
+                state.Bounds(-1, lo, hi);
+                Pose.Transform w = state.JointWorld(joint);
+                Console.WriteLine("{0}: {1} joints, {2} tissues, format {3}; {4} bent{5}, now at ({6:F3}, {7:F3}, {8:F3}); "
+                                  + "posed height {9:F3}", args[0], rig.JointCount, rig.TissueCount, rig.FormatVersion,
+                                  rig.Joint(joint).Name, clamped ? " (clamped)" : "", w.Translation[0],
+                                  w.Translation[1], w.Translation[2], hi[2] - lo[2]);
+            }
+        } catch (Pose.PoseException e) {
+            Console.Error.WriteLine("sample: " + e.Message);
+            return 1;
+        }
+        return 0;
+    }
+}
