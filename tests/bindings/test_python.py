@@ -9,6 +9,7 @@ tissue's positions bit for bit; then errors, views, bounds and the bridge.
 The libraries come from $POSE_LIBRARY_PATH (the build tree).
 """
 import os
+import shutil
 import subprocess
 import sys
 import unittest
@@ -18,9 +19,13 @@ CLIP, MAP = (sys.argv[5:7] + [None, None])[:2] if len(sys.argv) > 5 else (None, 
 TIME = 2.0
 
 # Install the package as a user would, with no index: setuptools from the system.
-target = os.path.join(SCRATCH, "site")
-subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--no-index", "--upgrade", "--target", target,
-                os.path.join(SOURCE, "bindings", "python")], check=True)
+# From a copy, as pip builds in the folder it is given.
+target, copy = os.path.join(SCRATCH, "site"), os.path.join(SCRATCH, "python")
+shutil.rmtree(copy, ignore_errors=True)
+shutil.copytree(os.path.join(SOURCE, "bindings", "python"), copy,
+                ignore=shutil.ignore_patterns("build", "*.egg-info", "__pycache__"))
+subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--no-index", "--upgrade", "--target", target, copy],
+               check=True)
 sys.path.insert(0, target)
 import pose  # noqa: E402  (installed just above)
 
