@@ -4,6 +4,7 @@
  * deadband, limits, Euler composition) with hand-computed values, and the
  * ranges of motion a map gives the state it drives. */
 #include "bridge_test.h"
+#include "pb_warn.h"
 #include "mapping.h"
 #include "pb_math.h"
 
@@ -399,6 +400,29 @@ static void test_ranges(void **state)
     pose_rig_free(prig);
 }
 
+/* A key given twice in one object: JSON allows it, every lookup takes the
+ * first, so the second was ignored in silence. Now a warning names where. */
+static void test_duplicate_keys_warned(void **state)
+{
+    (void)state;
+    static const char json[] = "{\"scale\": 1, \"scale\": 2, \"channels\": [{\"channel\": \"A\", \"joint\": \"j\","
+                               " \"axis\": \"x\", \"calibration\": {\"offset\": 1, \"offset\": 3}}]}";
+    pb_warnings w;
+    memset(&w, 0, sizeof w);
+    pb_warnings *prev = pb_warnings_install(&w);
+    pb_mapping *m = NULL;
+    pb_error err = {{0}};
+    const pose_status st = pb_mapping_parse(json, sizeof json - 1, "dup.json", &m, &err);
+    pb_warnings_install(prev);
+    if (st != POSE_OK)
+        fail_msg("%s", err.message);
+    pb_mapping_free(m);
+    assert_int_equal(w.count, 2);
+    assert_string_equal(w.text[0], "dup.json: the top-level object: key \"scale\" appears again; the first one is used");
+    assert_string_equal(w.text[1],
+                        "dup.json: channels[0].calibration: key \"offset\" appears again; the first one is used");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -408,6 +432,7 @@ int main(void)
         cmocka_unit_test(test_clinical_channels),
         cmocka_unit_test(test_shipped_maps_parse),
         cmocka_unit_test(test_ranges),
+        cmocka_unit_test(test_duplicate_keys_warned),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -8,6 +8,7 @@
 
 #include "mapping.h"
 #include "pb_math.h"
+#include "pb_warn.h"
 
 enum { MAP_MAX_FILE = 4u << 20, MAP_MAX_ENTRIES = 4096 };
 
@@ -484,6 +485,29 @@ static pose_status parse_root(pb_mapping *m, const cJSON *root, pb_error *err)
     return POSE_OK;
 }
 
+/* JSON allows a key twice in an object and cJSON keeps both, but every
+ * lookup here takes the first: the second is ignored, which its author did
+ * not mean. A warning names where ("channels[3]") and the key. */
+static void warn_duplicate_keys(const cJSON *node, const char *file, char *path, size_t len, size_t cap)
+{
+    int i = 0;
+    for (const cJSON *c = node->child; c; c = c->next, i++) {
+        if (cJSON_IsObject(node) && c->string)
+            for (const cJSON *k = node->child; k != c; k = k->next)
+                if (k->string && strcmp(k->string, c->string) == 0) {
+                    pb_warn("%s: %s: key \"%s\" appears again; the first one is used", file,
+                            len ? path : "the top-level object", c->string);
+                    break;
+                }
+        if (!c->child)
+            continue;
+        const int n = cJSON_IsObject(node) ? snprintf(path + len, cap - len, "%s%s", len ? "." : "", c->string)
+                                           : snprintf(path + len, cap - len, "[%d]", i);
+        warn_duplicate_keys(c, file, path, n > 0 && len + (size_t)n < cap ? len + (size_t)n : cap - 1, cap);
+        path[len] = '\0';
+    }
+}
+
 pose_status pb_mapping_parse(const char *json, size_t size, const char *name, pb_mapping **out, pb_error *err)
 {
     if (!out || (!json && size))
@@ -504,6 +528,8 @@ pose_status pb_mapping_parse(const char *json, size_t size, const char *name, pb
         pb_mapping_free(m);
         return s;
     }
+    char where[256] = "";
+    warn_duplicate_keys(root, m->path, where, 0, sizeof where);
     pose_status s = parse_root(m, root, err);
     cJSON_Delete(root);
     if (s) {
