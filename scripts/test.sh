@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Installs dependencies, builds pose from scratch and runs the whole test
 # suite: a normal build with gcc, then the suite again built with clang under
-# ASan+UBSan, then the threaded tests under TSan. Warnings are errors in every
-# build, so both compilers are checked. Exits non-zero on any failure.
+# ASan+UBSan, then the threaded tests (the examples' included) under TSan.
+# Warnings are errors in every build, so both compilers are checked. Exits non-zero on any failure.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 jobs=$(nproc)
@@ -23,5 +23,5 @@ echo "== build (gcc, RelWithDebInfo, with benchmarks) and test"
 run_suite "$root/build" "" -DPOSE_BUILD_BENCH=ON   # benchmarks are built (not run) so they keep compiling
 echo "== build with clang and test under ASan+UBSan"
 CC=clang CXX=clang++ run_suite "$root/build-asan" "" -DPOSE_SANITIZE=ON
-echo "== threaded tests under TSan"
-run_suite "$root/build-tsan" "threads" -DPOSE_TSAN=ON -DPOSE_BUILD_EXAMPLES=OFF
+echo "== threaded tests under TSan (the examples' threads too)"
+run_suite "$root/build-tsan" "threads" -DPOSE_TSAN=ON
