@@ -36,3 +36,15 @@ if(POSE_CONFIG_BRIDGE)
   install(FILES "${PROJECT_BINARY_DIR}/pose_bridge.pc" DESTINATION "${CMAKE_INSTALL_LIBDIR}/pkgconfig")
 endif()
 install(FILES "${PROJECT_SOURCE_DIR}/LICENSE" DESTINATION "${CMAKE_INSTALL_DATADIR}/doc/pose" OPTIONAL)
+
+# pose_install_ready: every target `cmake --install` copies, and nothing else
+# (not the tests), so a build of just the tools and libraries can be installed:
+# scripts/demo.sh builds this. tests/examples/install_ready.sh checks that the
+# list covers every file the install rules take from the build tree.
+add_custom_target(pose_install_ready)
+foreach(tgt IN ITEMS pose pose_static pose_synth pose_bridge pose_bridge_static
+                     pose-synth pose-bake pose-bridge pose-render pose-view pose-export)
+  if(TARGET ${tgt})
+    add_dependencies(pose_install_ready ${tgt})
+  endif()
+endforeach()

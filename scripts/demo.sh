@@ -89,16 +89,14 @@ fi
 stage "2/6 build (Release, $build)"
 cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >>"$log" 2>&1 ||
     die "cmake configure failed; see $log"
-# Only what the demo runs: the test suite is scripts/test.sh's job.
-targets=()
+# The tools and libraries, everything `cmake --install` copies (so that works after
+# the demo), not the test suite: that is scripts/test.sh's job.
 available=$(cmake --build "$build" --target help 2>/dev/null)
-for t in pose-synth pose-bake pose-bridge pose-render pose-export pose-view; do
-    grep -q "^$t:" <<<"$available" && targets+=("$t")
-done
 grep -q "^pose-render:" <<<"$available" ||
     die "pose-render is not configured (needs libosmesa6-dev and libpng-dev); see $log"
-cmake --build "$build" -j "$jobs" --target "${targets[@]}" >>"$log" 2>&1 || die "build failed; see $log"
-echo "built: ${targets[*]}"
+cmake --build "$build" -j "$jobs" --target pose_install_ready >>"$log" 2>&1 || die "build failed; see $log"
+echo "built: $(for t in pose-synth pose-bake pose-bridge pose-render pose-export pose-view; do
+    grep -q "^$t:" <<<"$available" && printf '%s ' "$t"; done)and the libraries (cmake --install $build works now)"
 
 render=$(tool pose-render)
 export_tool=$(tool pose-export)

@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0
  * quickstart.c: load a rig, bend one joint, pose the whole anatomy and see
  * how far each tissue moved.
- * Build: cc quickstart.c $(pkg-config --cflags --libs pose) -lm
- * Run:   ./a.out patient.rig [JOINT] */
+ * Build: cc quickstart.c $(pkg-config --cflags --libs pose) -Wl,-rpath,$(pkg-config --variable=libdir pose) -lm -o quickstart
+ * Run:   ./quickstart patient.rig [JOINT] */
 #include <math.h>
 #include <stdio.h>
 

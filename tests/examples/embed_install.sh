@@ -28,12 +28,15 @@ grep -q "wrote 3 OBJ files" "$tmp/run-cmake.log"
 ldd "$tmp/embed-cmake/embed" >"$tmp/ldd.log"
 grep -q "$tmp/prefix/.*libpose.so" "$tmp/ldd.log"
 
-# 2. Makefile: pkg-config from the prefix. --define-prefix makes pose.pc
-# answer for where it lies, since it was installed with --prefix after configure.
+# 2. Makefile: pkg-config from the prefix, PKG_CONFIG_PATH on make's command line as the
+# README writes it (not in the environment). --define-prefix makes pose.pc answer for where
+# it lies, since it was installed with --prefix after configure.
 multiarch=$(gcc -print-multiarch 2>/dev/null || true)
-export PKG_CONFIG_PATH="$tmp/prefix/lib/pkgconfig:$tmp/prefix/lib/$multiarch/pkgconfig"
+pc_path="$tmp/prefix/lib/pkgconfig:$tmp/prefix/lib/$multiarch/pkgconfig"
+unset PKG_CONFIG_PATH
 make -s -C "$src/examples/embed" OUT="$tmp/embed-make" PKG_CONFIG="pkg-config --define-prefix" \
-    CFLAGS="-O2 -Wall -Wextra -Werror"
+    PKG_CONFIG_PATH="$pc_path" CFLAGS="-O2 -Wall -Wextra -Werror"
+export PKG_CONFIG_PATH="$pc_path"
 "$tmp/embed-make/embed" "$tmp/bar.rig" "$tmp/out/make" 60 10 | tee "$tmp/run-make.log"
 grep -q "wrote 6 OBJ files" "$tmp/run-make.log"
 
@@ -45,12 +48,17 @@ if cmp -s "$tmp/out/cmake/skin_0000.obj" "$tmp/out/cmake/skin_0020.obj"; then
     exit 1
 fi
 
-# 3. The README quickstart, compiled as its comment says.
-# shellcheck disable=SC2046 # the flags are meant to split into words
-cc -std=c11 -Wall -Wextra -Werror -o "$tmp/quickstart" "$src/examples/quickstart/quickstart.c" \
-    $(pkg-config --define-prefix --cflags --libs pose) -lm \
-    -Wl,-rpath,"$(pkg-config --define-prefix --variable=libdir pose)"
-"$tmp/quickstart" "$tmp/bar.rig" | tee "$tmp/run-quickstart.log"
+# 3. The README quickstart, built and run by its own Build: and Run: lines, word for word
+# (the README's custom-prefix section gives the same Build: line), with no LD_LIBRARY_PATH:
+# the rpath finds the prefix's libpose.so.
+qs="$src/examples/quickstart/quickstart.c"
+build_line=$(sed -n 's/^ \* Build: //p' "$qs")
+run_line=$(sed -n 's/^ \* Run: *//p' "$qs" | sed 's/ \[JOINT\] \*\/$//; s/patient\.rig/bar.rig/')
+grep -qF -- "$build_line" "$src/README.md" ||
+    { echo "embed_install: README's build-by-hand section lacks the quickstart's Build: line" >&2; exit 1; }
+rm -rf "$tmp/qs" && mkdir -p "$tmp/qs" && cp "$qs" "$tmp/bar.rig" "$tmp/qs/"
+(cd "$tmp/qs" && unset LD_LIBRARY_PATH && eval "$build_line -Wall -Wextra -Werror" &&
+    eval "$run_line") | tee "$tmp/run-quickstart.log"
 grep -q "moved up to" "$tmp/run-quickstart.log"
 
 # 4. The bridge, when installed: pose::bridge (CMake) and pose_bridge.pc (pkg-config).
@@ -83,4 +91,26 @@ if [ -f "$tmp/prefix/include/pose/bridge.h" ]; then
         exit 1
     fi
 fi
+# 5. The installed tools run from the prefix; pose-bridge replay without --map points at the
+# installed mappings; the installed Python package finds the prefix's libpose by itself.
+"$tmp/prefix/bin/pose-synth" --help >/dev/null
+if [ -x "$tmp/prefix/bin/pose-bridge" ]; then
+    if "$tmp/prefix/bin/pose-bridge" replay "$src/data/hid/mannequin_sit_to_stand.hid" --rig "$tmp/bar.rig" \
+        2>"$tmp/replay-nomap.log"; then
+        echo "embed_install: replay of a HID recording without --map succeeded" >&2
+        exit 1
+    fi
+    grep -q "hint: .*--map.* $tmp/prefix/bin/../share/pose/maps: .*hid_mannequin_bar.json" "$tmp/replay-nomap.log" ||
+        { cat "$tmp/replay-nomap.log" >&2; echo "embed_install: no hint at the installed maps" >&2; exit 1; }
+    test -f "$tmp/prefix/share/pose/maps/hid_mannequin_full_body.json"
+fi
+py=$(command -v /usr/bin/python3 || command -v python3 || true)
+if [ -n "$py" ]; then
+    site=$(find "$tmp/prefix" -type d -name site-packages | head -n 1)
+    env -u POSE_LIBRARY_PATH PYTHONPATH="$site" PYTHONDONTWRITEBYTECODE=1 "$py" -c \
+        "import pose, sys; rig = pose.Rig(sys.argv[1]); print('python:', rig.joint_count, 'joints', pose.__file__)" \
+        "$tmp/bar.rig" | tee "$tmp/python.log"
+    grep -q "python: 4 joints $tmp/prefix/" "$tmp/python.log"
+fi
+test -f "$tmp/prefix/share/pose/csharp/Pose.cs"
 echo "embed_install: OK"
