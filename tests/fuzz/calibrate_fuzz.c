@@ -38,14 +38,11 @@ static int write_file(const char *path, const uint8_t *data, size_t size)
 /* The rewritten file is JSON whose "channels" entry 0 holds the calibration written. */
 static void check_two_point(const char *path, const double raw[2], const double deg[2])
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
+    char *text;
+    size_t n;
+    pb_error err;
+    if (pb_read_file(path, (size_t)16 << 20, &text, &n, &err) != POSE_OK)
         abort();
-    char *text = malloc(1 << 24);
-    const size_t n = text ? fread(text, 1, (1 << 24) - 1, f) : 0;
-    fclose(f);
-    if (!text)
-        return;
     cJSON *root = cJSON_ParseWithLength(text, n);
     if (!root)
         abort();

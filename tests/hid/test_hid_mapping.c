@@ -229,6 +229,31 @@ static void copy_file(const char *from, const char *to)
     fclose(b);
 }
 
+/* Found by fuzz_calibrate: an entry that is not an object took a calibration
+ * that was never written (reported as done), and text after the JSON value
+ * was dropped by the rewrite. Both are errors now, the file untouched. */
+static void test_calibration_refuses_what_it_cannot_write(void **state)
+{
+    (void)state;
+    char map[1024];
+    snprintf(map, sizeof map, "%s/calibrate_bad.json", getenv("POSE_TEST_TMP") ? getenv("POSE_TEST_TMP") : "/tmp");
+    const double raw[2] = {0, 90}, deg[2] = {0, 90};
+    pb_error err;
+    static const char *const bad[][2] = {
+        {"{\"channels\": [\"HIP_L.flex\"]}\n", "\"channels\" entry 0 is not an object"},
+        {"{\"channels\": [{\"channel\": \"A\"}]}\n}, \"more\": 1}\n", "near byte 33 (text after the JSON value)"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        FILE *f = fopen(map, "w");
+        assert_non_null(f);
+        fputs(bad[i][0], f);
+        fclose(f);
+        assert_int_equal(pb_calibrate_write(map, NULL, 0, raw, deg, &err), POSE_ERR_FORMAT);
+        if (!strstr(err.message, bad[i][1]))
+            fail_msg("'%s' lacks '%s'", err.message, bad[i][1]);
+    }
+}
+
 static void test_calibration_round_trip(void **state)
 {
     (void)state;
@@ -333,6 +358,7 @@ int main(void)
         cmocka_unit_test(test_full_body_follows),
         cmocka_unit_test(test_bar_follows),
         cmocka_unit_test(test_calibration_round_trip),
+        cmocka_unit_test(test_calibration_refuses_what_it_cannot_write),
         cmocka_unit_test(test_neutral_calibration),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -37,12 +37,20 @@ static pose_status load_json(const char *path, cJSON **root, cJSON **entry, cons
     pose_status st = pb_read_file(path, (size_t)16 << 20, &text, &size, err);
     if (st != POSE_OK)
         return st;
-    *root = cJSON_ParseWithLength(text, size);
-    if (!*root) {
-        const char *at = cJSON_GetErrorPtr();
+    /* The file is rewritten from what is parsed: text after the first JSON
+     * value would be lost, so it is an error like any other. */
+    const char *end = NULL;
+    *root = cJSON_ParseWithLengthOpts(text, size, &end, 0);
+    while (*root && end < text + size && (*end == ' ' || *end == '\t' || *end == '\r' || *end == '\n'))
+        end++;
+    if (!*root || end != text + size) {
+        const int trailing = *root != NULL;
+        const char *at = trailing ? end : cJSON_GetErrorPtr();
         long off = at && at >= text && at <= text + size ? (long)(at - text) : -1;
+        cJSON_Delete(*root);
         free(text);
-        return pb_fail(err, POSE_ERR_FORMAT, "%s: invalid JSON near byte %ld", path, off);
+        return pb_fail(err, POSE_ERR_FORMAT, "%s: invalid JSON near byte %ld%s", path, off,
+                       trailing ? " (text after the JSON value)" : "");
     }
     free(text);
     cJSON *chans = cJSON_GetObjectItemCaseSensitive(*root, "channels");
@@ -56,6 +64,10 @@ static pose_status load_json(const char *path, cJSON **root, cJSON **entry, cons
     {
         cJSON *c = cJSON_GetObjectItemCaseSensitive(e, "channel");
         if (name ? (cJSON_IsString(c) && strcmp(c->valuestring, name) == 0) : i == index) {
+            if (!cJSON_IsObject(e)) { /* a calibration set on it would not be written */
+                cJSON_Delete(*root);
+                return pb_fail(err, POSE_ERR_FORMAT, "%s: \"channels\" entry %d is not an object", path, i);
+            }
             *entry = e;
             return POSE_OK;
         }
@@ -238,7 +250,7 @@ pose_status pb_calibrate_write_neutral(const char *map_path, const pb_mapping *m
             break;
         const pb_map_channel *m = &map->channels[i];
         const double g = entry_gain(m);
-        if (isfinite(neutral_raw[i]) && isfinite(g) && g != 0.0) {
+        if (cJSON_IsObject(e) && isfinite(neutral_raw[i]) && isfinite(g) && g != 0.0) {
             /* The neutral reading becomes 0 degrees; 90 degrees stays 90 / gain raw units away. */
             const double raw[2] = {neutral_raw[i], neutral_raw[i] + 90.0 / g}, deg[2] = {0.0, 90.0};
             cJSON *cal = two_point(raw, deg);
