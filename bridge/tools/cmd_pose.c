@@ -27,7 +27,8 @@ static void help(FILE *f)
             "  --map MAP       mapping JSON (clips: default joints of the same name)\n"
             "  --skeleton ASF  the .asf of an .amc (default: NN.asf beside NN_MM.amc)\n"
             "  --times LIST    recorded times in seconds, comma-separated (e.g. 0.5,2,7.25)\n"
-            "  --json          {\"times\":[{\"t\":0.5,\"held\":false,\"joints\":{\"knee_r\":[x,y,z],...}},...]}\n"
+            "  --json          {\"times\":[{\"t\":0.5,\"held\":false,\"clamped\":0,\"joints\":{\"knee_r\":[x,y,z],...}},...]}\n"
+            "                  (clamped: joints whose request a limit changed at that time)\n"
             "Prints every rig joint's world position (the rig's unit: metres for a baked rig, the\n"
             "clip's unit for a skeleton rig) after pose_bridge_pose_at and pose_apply, per time;\n"
             "without --json a table. Exits 1 when a time is past the recording's end.\n");
@@ -105,9 +106,13 @@ static void print_time(const pose_args *a, const pose_rig *rig, const pose_state
 {
     size_t n = pose_rig_joint_count(rig);
     if (a->json) {
-        printf("%s{\"t\":%.6g,\"held\":%s,\"joints\":{", first ? "" : ",", t, fr->held ? "true" : "false");
+        printf("%s{\"t\":%.6g,\"held\":%s,\"clamped\":%d,\"joints\":{", first ? "" : ",", t,
+               fr->held ? "true" : "false", fr->clamped);
     } else {
-        printf("t = %.3f s%s\n", t, fr->held ? "  (held: the source was silent or faulty)" : "");
+        printf("t = %.3f s%s", t, fr->held ? "  (held: the source was silent or faulty)" : "");
+        if (fr->clamped)
+            printf("  (%d joints clamped by their limits)", fr->clamped);
+        putchar('\n');
     }
     for (size_t j = 0; j < n; j++) {
         pose_joint_info info;

@@ -11,8 +11,8 @@ mkdir -p "$tmp"
 log="$src/data/can-rig/sit_stand_arm_raise.log" map="$src/bridge/maps/can_rig_bar.json"
 "$bridge" pose "$log" --rig "$rig" --map "$map" --times 2,5.3,6 --json >"$tmp/pose.json"
 cat "$tmp/pose.json"
-grep -q '^{"source":".*","times":\[{"t":2,"held":false,"joints":{"joint0":\[0.000000,0.000000,0.000000\],"joint1":\[' "$tmp/pose.json"
-grep -q '{"t":5.3,"held":true,' "$tmp/pose.json"
+grep -q '^{"source":".*","times":\[{"t":2,"held":false,"clamped":0,"joints":{"joint0":\[0.000000,0.000000,0.000000\],"joint1":\[' "$tmp/pose.json"
+grep -q '{"t":5.3,"held":true,"clamped":[0-9]*,' "$tmp/pose.json"
 grep -q '{"t":6,"held":false,' "$tmp/pose.json"
 # joint3 (the bar's tip) off the bar's axis when seated, on it when standing
 tip() { grep -o "{\"t\":$1,[^}]*}" "$tmp/pose.json" | grep -o '"joint3":\[[^]]*\]' | tr -d '"joint3:[]'; }
