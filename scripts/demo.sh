@@ -95,8 +95,11 @@ available=$(cmake --build "$build" --target help 2>/dev/null)
 grep -q "^pose-render:" <<<"$available" ||
     die "pose-render is not configured (needs libosmesa6-dev and libpng-dev); see $log"
 cmake --build "$build" -j "$jobs" --target pose_install_ready >>"$log" 2>&1 || die "build failed; see $log"
-echo "built: $(for t in pose-synth pose-bake pose-bridge pose-render pose-export pose-view; do
-    grep -q "^$t:" <<<"$available" && printf '%s ' "$t"; done)and the libraries (cmake --install $build works now)"
+built=""
+for t in pose-synth pose-bake pose-bridge pose-render pose-export pose-view; do
+    if grep -q "^$t:" <<<"$available"; then built+="$t "; fi
+done
+echo "built: ${built}and the libraries (cmake --install $build works now)"
 
 render=$(tool pose-render)
 export_tool=$(tool pose-export)
