@@ -243,8 +243,12 @@ POSE_BRIDGE_API int pose_bridge_wait(pose_bridge *bridge, int timeout_ms);
 /**
  * Warnings the source's files raised while loading (a HID descriptor's
  * trailing bytes, a DBC's repeated pseudo-message signals, a mapping's
- * duplicate key ...): each names the file and line or offset. Valid until
- * the bridge is closed; NULL past the count. The first 32 are kept. @since 0.2
+ * duplicate key ...) and while playing (a recording's time stamp jumping
+ * more than a minute or going back, a line cut by a killed recorder, a HID
+ * report longer than its descriptor): each names the file and line or
+ * offset. The list may grow while the bridge thread plays; entries already
+ * counted do not change. Valid until the bridge is closed; NULL past the
+ * count. The first 32 are kept. @since 0.2
  */
 POSE_BRIDGE_API size_t pose_bridge_warning_count(const pose_bridge *bridge);
 POSE_BRIDGE_API const char *pose_bridge_warning(const pose_bridge *bridge, size_t index);
