@@ -14,7 +14,11 @@
  * elbow's axis lies 10 degrees off the perpendicular to the humerus, CMU's on
  * it, and the rig's rest elbow carries 12 degrees across it), trunk 6-7 (the
  * rig's thorax followed a clip joint that turns the neck); 01_01 clamped in
- * 14.6% of its frames under the rig's AAOS ranges, 131_01 in 32.6%.
+ * 14.6% of its frames under the rig's AAOS ranges, 131_01 in 32.6%. Since
+ * the hands' mean pronation reaches the elbows (retarget.c, mean_reference)
+ * the forearms lie 2.9 degrees (median) off the clip's: the baked elbow's
+ * pronation axis lies 10 degrees off its bone, and the abduction that would
+ * make up for it is limited to 5.
  */
 #include "bridge_apply.h"
 #include "bridge_test.h"
@@ -55,14 +59,17 @@ static const body_case CASES[] = {
       {"LeftShoulder", "LeftElbow"},
       {"LeftElbow", "LeftWrist"},
       {"Hips", "lowerneck"}},
-     /* Not the 5% issue 10 asks for: the right hand deviates radially by
-      * 20-50 degrees from its mean posture in a fifth of the frames (near
-      * 40 for 80 frames with the arm raised), where AAOS gives the wrist 20
-      * and daily activities use at most 17 (Ryu et al. 1991): the hand's
-      * markers, not a range to widen. The left foot turns inward by up to
-      * 40 about the shank (the template's 25). Held at what it is so that it
-      * does not grow. */
-     0.31},
+     /* Not the 5% issue 10 asks for (31.0%): the right hand, in its own
+      * CMU axes and with its twist about the forearm taken out as
+      * pronation, moves from its mean posture by 30 degrees (sd) along its
+      * main axis and 21 across it, so no choice of the hand's roll about
+      * the forearm keeps its deviation within a wrist's 20 / 40 (the
+      * fewest frames past it, at a roll fitted to the range, are still
+      * 12%): 229 frames ask for radial deviation 17 past the range
+      * (median). The left wrist 50 frames, the left foot 65 (inward by up
+      * to 40 about the shank, the template's 25). Held at what it is so
+      * that it does not grow. */
+     0.315},
     {"mocap/cmu-bvh/01_01.bvh",
      NULL,
      "cmu_cgspeed_bvh_to_full_body.json",

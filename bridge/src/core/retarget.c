@@ -301,6 +301,17 @@ static void neutral_base(const pb_retarget *r, int k, double out[4])
  * hand or foot spends a clip around its relaxed posture. The reference of
  * those clip joints becomes their parent's reference with the mean local
  * rotation, which the rig's neutral posture then receives.
+ *
+ * Only the mean's swing, where the rig's parent is a hinge that takes this
+ * joint's twist about its bone with a wider range than the joint's own (an
+ * elbow's +-80 of pronation against a wrist's +-20): the mean twist about
+ * the forearm is the clip's average pronation, and kept in the reference it
+ * would turn the hand's flexion axis by that much against the rig's, so
+ * that the rig's wrist received flexion as deviation (131_01: a 22 degree
+ * mean pronation on the right, 10 on the left, on top of CMU's 30 degrees
+ * between elbow hinge and hand axes). Without it the twist reaches the elbow
+ * as pronation and both hands keep the one offset of the hinges. A foot
+ * keeps its whole mean: a knee's +-15 could not hold a mean toe-out.
  */
 static pose_status mean_reference(pb_retarget *r, const pb_mapping *map)
 {
@@ -324,6 +335,12 @@ static pose_status mean_reference(pb_retarget *r, const pb_mapping *map)
             leaf = !(r->src[k] >= 0 && is_descendant(rig, k, j));
         want[s] |= leaf;
         any |= leaf;
+        /* its twist about the parent's bone is the parent's to take (see above) */
+        const pb_hinge *P = J->parent >= 0 ? &r->hinge[J->parent] : NULL;
+        pb_hinge own;
+        if (leaf && P && P->driven && P->child == j && clinical_frame(J, &own) && P->lo[2] <= P->hi[2] &&
+            own.lo[2] <= own.hi[2] && P->hi[2] - P->lo[2] > own.hi[2] - own.lo[2])
+            want[s] |= 2;
     }
     if (any && pb_clip_mean_local(clip, want, mean) != 0) {
         free(want);
@@ -333,8 +350,22 @@ static pose_status mean_reference(pb_retarget *r, const pb_mapping *map)
     for (int c = 0; c < clip->joint_count && any; c++) {
         if (!want[c])
             continue;
-        double q[4];
-        pb_quat_mul(r->wq[clip->joints[c].parent], mean[c], q);
+        int p = clip->joints[c].parent;
+        double q[4], e[3], t[4], ti[4];
+        for (int a = 0; a < 3; a++)
+            e[a] = r->ref_p[c][a] - r->ref_p[p][a];
+        pb_quat_conj(r->wq[p], q);
+        pb_quat_rotate(q, e, e);
+        double l = pb_vec_len(e);
+        if ((want[c] & 2) && l > 1e-9) {
+            for (int a = 0; a < 3; a++)
+                e[a] /= l;
+            twist_part(mean[c], e, t);
+            pb_quat_conj(t, ti);
+            pb_quat_mul(ti, mean[c], mean[c]);
+            pb_quat_normalize(mean[c]);
+        }
+        pb_quat_mul(r->wq[p], mean[c], q);
         pb_quat_conj(q, r->ref_inv[c]);
     }
     free(want);
