@@ -58,9 +58,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     memcpy(words, argv, sizeof *argv * (size_t)argc); /* getopt_long permutes argv */
     pose_cli cli;
     pose_cli_begin(&cli, "fuzz", argc, argv, opts);
-    int steps = 0;
+    /* Each step takes a word, or a letter of a cluster of flags ("-jjj"). */
+    size_t steps = 0, most = (size_t)argc;
+    for (int i = 0; i < argc; i++)
+        most += strlen(words[i]);
     for (int c; (c = pose_cli_next(&cli)) != POSE_CLI_END && c != POSE_CLI_ERROR;) {
-        if (++steps > 2 * argc) /* each step takes at least one word */
+        if (++steps > most)
             abort();
         if (cli.value && !from_line(cli.value, words, argc))
             abort();
