@@ -275,6 +275,15 @@ POSE_API int pose_rig_find_tissue(const pose_rig *rig, const char *name);
 POSE_API pose_status pose_rig_tissue_info(const pose_rig *rig, int tissue, pose_tissue_info *out);
 /** Describe the tet mesh and weights. @since 0.1 */
 POSE_API pose_status pose_rig_tet_info(const pose_rig *rig, pose_tet_info *out);
+/**
+ * Where tissue `tissue`'s vertices sit in the tet mesh: per vertex the index
+ * of its embedding tet (*tet, vertex_count entries) and its 4 barycentric
+ * coordinates in that tet (*bary, 4 * vertex_count), owned by the rig. What
+ * pose_apply carries each vertex with; exporters use it to give tissue
+ * vertices the tet vertices' skinning weights. @since 0.2
+ */
+POSE_API pose_status pose_rig_tissue_embedding(const pose_rig *rig, int tissue, const uint32_t **tet,
+                                               const float **bary);
 /** Free-form provenance text stored in the rig ("" when none); owned by the rig. @since 0.1 */
 POSE_API const char *pose_rig_metadata(const pose_rig *rig);
 /** The rig file format version `rig` was loaded from (a rig made by

@@ -1,0 +1,75 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
+# pose-export's session outputs, read back by the tools they are for.
+#   gltf: a 4 s replay of a CMU walk (01_01, 120 Hz, every 12th frame) as an
+#         animated .glb, loaded by three.js's GLTFLoader under node (npm
+#         `three`, pinned by tests/examples/gltf/package-lock.json, installed
+#         with npm ci into TMP once): its skinned meshes, joints, clip length,
+#         and the skin posed by three.js at 2 s against pose-export's own pose
+#         of frame 240 (LBS both).
+#   pvd:  a ParaView series of the same replay's first second, every frame
+#         read back with meshio (python3-meshio) with the expected counts.
+# Exits 77 (skipped, with the reason) when node/npm or meshio is missing.
+# usage: export_session.sh gltf|pvd POSE_EXPORT RIG SOURCE_DIR TMP
+set -euo pipefail
+kind=$1 export_bin=$2 rig=$3 src=$4 tmp=$5
+clip="$src/data/mocap/cmu-bvh/01_01.bvh"
+map="$src/bridge/maps/cmu_cgspeed_bvh_to_full_body.json"
+mkdir -p "$tmp"
+rm -rf "$tmp/$kind"
+mkdir -p "$tmp/$kind"
+json() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])" "$@"; }
+
+case $kind in
+gltf)
+  if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
+    echo "export_session gltf: skipped: node and npm are needed to run three.js's GLTFLoader"
+    exit 77
+  fi
+  node_dir="$tmp/node"
+  if [ ! -f "$node_dir/node_modules/three/package.json" ] ||
+     ! cmp -s "$src/tests/examples/gltf/package-lock.json" "$node_dir/package-lock.json"; then
+    rm -rf "$node_dir"
+    mkdir -p "$node_dir"
+    cp "$src/tests/examples/gltf/package.json" "$src/tests/examples/gltf/package-lock.json" "$node_dir/"
+    if ! (cd "$node_dir" && timeout 120 npm ci --no-audit --no-fund --loglevel=error >npm.log 2>&1); then
+      echo "export_session gltf: skipped: npm ci could not install three (no registry?):"
+      tail -5 "$node_dir/npm.log"
+      rm -rf "$node_dir/node_modules"
+      exit 77
+    fi
+  fi
+  cp "$src/tests/examples/gltf/check_glb.mjs" "$node_dir/"
+  "$export_bin" "$rig" --method lbs --source "$clip" --map "$map" --frames 0-480:12 \
+    --gltf-anim "$tmp/gltf/walk.glb" --json >"$tmp/gltf/session.json"
+  "$export_bin" "$rig" --method lbs --source "$clip" --map "$map" --frame 240 \
+    --glb "$tmp/gltf/frame240.glb" --json >"$tmp/gltf/frame.json"
+  cat "$tmp/gltf/session.json"
+  [ "$(json "$tmp/gltf/session.json" frames)" = 41 ] || { echo "expected 41 frames"; exit 1; }
+  meshes=$(json "$tmp/gltf/session.json" skinned_meshes)
+  [ "$meshes" -gt 1 ] || { echo "expected skin and bones, got $meshes skinned meshes"; exit 1; }
+  ls -l "$tmp/gltf/walk.glb" "$tmp/gltf/frame240.glb"
+  # 19 joints in the full-body template; mean skin distance within 5 mm of pose-export's pose
+  node "$node_dir/check_glb.mjs" "$tmp/gltf/walk.glb" "$meshes" 19 4.0 "$tmp/gltf/frame240.glb" 2.0 skin 0.005
+  ;;
+pvd)
+  py=""
+  for p in /usr/bin/python3 python3; do # Debian's python3 first: python3-meshio is its
+    if "$p" -c "import meshio" 2>/dev/null; then py=$p; break; fi
+  done
+  if [ -z "$py" ]; then
+    echo "export_session pvd: skipped: python3-meshio is not installed"
+    exit 77
+  fi
+  "$export_bin" "$rig" --source "$clip" --map "$map" --frames 0-120:30 \
+    --pvd "$tmp/pvd/walk.pvd" --json >"$tmp/pvd/session.json"
+  cat "$tmp/pvd/session.json"
+  ls -l "$tmp/pvd"
+  "$py" "$src/tests/examples/check_pvd.py" "$tmp/pvd/walk.pvd" 5 \
+    "$(json "$tmp/pvd/session.json" tissue_vertices)" "$(json "$tmp/pvd/session.json" tissue_triangles)"
+  ;;
+*)
+  echo "usage: $0 gltf|pvd POSE_EXPORT RIG SOURCE_DIR TMP" >&2
+  exit 2
+  ;;
+esac
