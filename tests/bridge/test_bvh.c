@@ -241,7 +241,9 @@ static void test_no_channels(void **state)
 
 /* Values no joint or capture volume can have (1e30 in a BVH, 1e300 in an
  * AMC) are kept but warned about, naming the line, the first value and the
- * count; a radians value too large for degrees is refused (it was inf). */
+ * count; so is a frame time beyond a minute (a replay would stall that
+ * long per frame); a radians value too large for degrees is refused (it was
+ * inf). */
 static void test_absurd_values_warned(void **state)
 {
     (void)state;
@@ -254,7 +256,13 @@ static void test_absurd_values_warned(void **state)
     assert_int_equal(parse_text(t, &c, &err), POSE_OK);
     free(t);
     pb_clip_free(c);
-    assert_int_equal(w.count, 1);
+    t = join(HIER, "MOTION\nFrames: 1\nFrame Time: 3600\n0 0 0 0 0 0 0 0 0 0 0 0 0\n");
+    assert_int_equal(parse_text(t, &c, &err), POSE_OK);
+    free(t);
+    pb_clip_free(c);
+    assert_int_equal(w.count, 2);
+    if (!strstr(w.text[1], "hand.bvh:32: frame time 3600 s: a real-time replay waits that long"))
+        fail_msg("%s", w.text[1]);
     if (!strstr(w.text[0], "hand.bvh:34: frame 1 value 3 is 1e+30, beyond +-1e+06") ||
         !strstr(w.text[0], "2 such values"))
         fail_msg("%s", w.text[0]);
@@ -267,9 +275,9 @@ static void test_absurd_values_warned(void **state)
     static const char amc[] = ":DEGREES\n1\nroot 0 0 0 0 0 0\na 5\n2\nroot 0 0 0 0 0 0\na 1e300\n";
     if (pb_amc_parse(c, amc, strlen(amc), "t.amc", &err) != POSE_OK)
         fail_msg("%s", err.message);
-    assert_int_equal(w.count, 2);
-    if (!strstr(w.text[1], "t.amc:7: bone a value 1e+300 is beyond +-1e+06"))
-        fail_msg("%s", w.text[1]);
+    assert_int_equal(w.count, 3);
+    if (!strstr(w.text[2], "t.amc:7: bone a value 1e+300 is beyond +-1e+06"))
+        fail_msg("%s", w.text[2]);
     static const char rad[] = ":RADIANS\n1\nroot 0 0 0 0 0 0\na 1e307\n";
     assert_int_equal(pb_amc_parse(c, rad, strlen(rad), "r.amc", &err), POSE_ERR_FORMAT);
     if (!strstr(err.message, "r.amc:4: bone a: value 0 is not finite in degrees"))

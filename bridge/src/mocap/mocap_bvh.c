@@ -12,6 +12,7 @@
 #include "pb_math.h"
 #include "pb_text.h"
 #include "pb_warn.h"
+#include "timeline.h"
 
 enum { BVH_MAX_DEPTH = 256, BVH_MAX_FILE = 1u << 30 };
 
@@ -189,6 +190,11 @@ static pose_status parse_motion(bvh_parser *P)
         return pb_fail(P->err, POSE_ERR_FORMAT, "%s:%ld: frame time %g s is not in (0, 3600]", P->t.name,
                        P->t.line, ft);
     c->frame_time = ft;
+    /* Frames are evenly spaced, so this is the one time a clip can jump: a
+     * real-time replay waits a frame time between frames. */
+    if ((double)ft * 1e9 > (double)PB_TIMELINE_MAX_GAP_NS)
+        pb_warn("%s:%ld: frame time %g s: a real-time replay waits that long between frames", P->t.name,
+                P->t.line, ft);
     /* Each value takes at least two bytes ("0 "): refuse counts the file
      * cannot hold before allocating anything. */
     size_t remain = (size_t)(P->t.end - P->t.p);
