@@ -34,11 +34,12 @@ run_target() { # <name> <seed corpus>: runs one target, leaves its figures in <w
   local name=$1 seeds=$2 work="$runs/$1" bin
   bin=$(find "$build" -path "$runs" -prune -o -type f -name "$name" -perm -u+x -print | head -n 1)
   mkdir -p "$work/corpus" "$work/crashes"
+  touch "$work/started" # crashes of earlier runs stay, but are not this run's
   "$bin" -max_total_time=$((minutes * 60)) -print_final_stats=1 \
     -artifact_prefix="$work/crashes/" "$work/corpus" "$seeds" >"$work/log" 2>&1 || true
   local execs crashes
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$work/log" | tail -n 1)
-  crashes=$(find "$work/crashes" -type f | wc -l)
+  crashes=$(find "$work/crashes" -type f -newer "$work/started" | wc -l)
   echo "$name: ${execs:-?} executions, $crashes crashes, $minutes min (log $work/log)" >"$work/result"
 }
 
