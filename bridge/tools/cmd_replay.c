@@ -229,8 +229,10 @@ static int run(int argc, char **argv)
             pb_cli_hint_maps(a.source);
         goto done;
     }
-    for (size_t i = 0; i < pose_bridge_warning_count(br); i++)
-        fprintf(stderr, "warning: %s\n", pose_bridge_warning(br, i));
+    /* The files' warnings, then those the bridge thread finds while playing (a time jump ...). */
+    size_t warned = 0;
+    for (; warned < pose_bridge_warning_count(br); warned++)
+        fprintf(stderr, "warning: %s\n", pose_bridge_warning(br, warned));
     int tty = isatty(2) && !a.quiet;
     double period = 1.0 / a.host_rate, next = now_s(), last_status = 0, fps_t = next;
     unsigned long long host_frames = 0, applied = 0, held = 0, fps_poses = 0;
@@ -244,6 +246,8 @@ static int run(int argc, char **argv)
             fprintf(stderr, "pose-bridge replay: %s\n", pose_last_error());
             goto done;
         }
+        for (; warned < pose_bridge_warning_count(br); warned++)
+            fprintf(stderr, "%swarning: %s\n", tty ? "\n" : "", pose_bridge_warning(br, warned));
         applied += fr.fresh != 0;
         held += fr.held != 0;
         clamped += fr.clamped;
