@@ -29,16 +29,20 @@
  *                               the CMU subject's .asf beside it (01_01.amc -> 01.asf)
  *   path.hid                    hid-recorder file (simulated HID device)
  *   path.log                    candump -l log (simulated CAN bus)
+ *   path.usbmon                 usbmon text capture (simulated vendor-class USB device)
  *   hid:VID:PID[:PAGE:USAGE]    live HID device (hex USB ids; optionally the top-level
  *                               collection's usage page and usage), through hidapi
  *   /dev/hidrawN                live HID device node
  *   can:IFACE  or  IFACE        live SocketCAN interface (can0, vcan0 ...)
+ *   usb:VID:PID[:SERIAL][/IF/EP]  live vendor-class USB device through libusb (hex ids,
+ *                               decimal interface, hex IN endpoint)
  *   KIND:PATH                   a file of another extension: bvh:, amc:,
- *                               hid-recording:, candump:
+ *                               hid-recording:, candump:, usbmon:
  *
- * HID and CAN sources need a mapping with "channels" (and, for CAN, its "can"
- * bus description, whose relative "dbc" path is taken from the mapping file's
- * folder, or from the working directory for map_json); clips map rig joints
+ * HID, CAN and USB sources need a mapping with "channels" (for CAN also its
+ * "can" bus description, whose relative "dbc" path is taken from the mapping
+ * file's folder, or from the working directory for map_json; for USB its
+ * "usb" frame layout); clips map rig joints
  * to clip joints of the same name without one. Recorded times count from the
  * recording's start (a hid-recorder file's times, a candump log's first
  * frame); a live source's from its first sample. Mappings speak the clinical
@@ -153,7 +157,7 @@ typedef struct pose_bridge_status {
     size_t size;                    /**< sizeof(pose_bridge_status): at least the 0.2 layout */
     pose_bridge_source_state state;
     int connected;                  /**< live device present (recorded sources: 1) */
-    const char *kind;               /**< "bvh", "asf-amc", "hid", "hid-replay", "can", "candump-replay" */
+    const char *kind;               /**< "bvh", "asf-amc", "hid", "hid-replay", "can", "candump-replay", "usb", "usbmon-replay" */
     uint64_t samples;               /**< source samples read */
     uint64_t drops;                 /**< samples rejected or lost (malformed, gaps in a counter) */
     uint64_t poses;                 /**< poses published */

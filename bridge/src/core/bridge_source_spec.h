@@ -19,6 +19,8 @@ typedef enum pb_spec_kind {
     PB_SPEC_HID_LIVE = 3, /**< hid:VID:PID[:PAGE:USAGE] or /dev/hidrawN */
     PB_SPEC_CANDUMP = 4,  /**< candump -l log */
     PB_SPEC_CAN_LIVE = 5, /**< SocketCAN interface */
+    PB_SPEC_USBMON = 6,   /**< usbmon text capture of a vendor-class USB device */
+    PB_SPEC_USB_LIVE = 7, /**< usb:VID:PID[:SERIAL][/IFACE/EP] through libusb */
 } pb_spec_kind;
 
 typedef struct pb_spec {
@@ -31,11 +33,14 @@ pose_status pb_spec_parse(const char *source, pb_spec *out, pb_error *err);
 /** The pb_source kind name of a spec's kind ("bvh", "asf-amc", "hid", "hid-replay", "can", "candump-replay"). */
 const char *pb_spec_kind_name(pb_spec_kind kind);
 static inline int pb_spec_is_clip(pb_spec_kind k) { return k == PB_SPEC_BVH || k == PB_SPEC_AMC; }
-static inline int pb_spec_is_live(pb_spec_kind k) { return k == PB_SPEC_HID_LIVE || k == PB_SPEC_CAN_LIVE; }
+static inline int pb_spec_is_live(pb_spec_kind k)
+{
+    return k == PB_SPEC_HID_LIVE || k == PB_SPEC_CAN_LIVE || k == PB_SPEC_USB_LIVE;
+}
 
 /** How to open a device source; zero means default. */
 typedef struct pb_spec_open_options {
-    const char *map_path;   /**< the mapping file: a CAN source's "can" bus description is read from it */
+    const char *map_path;   /**< the mapping file: a CAN source's "can" bus description (a USB source's "usb" frame) is read from it */
     const char *map_json;   /**< ... or the mapping as text (relative "dbc" paths: the working directory) */
     int as_fast_as_possible;/**< recordings: ignore recorded timing */
     int loop;               /**< recordings: start over at the end */
