@@ -7,10 +7,13 @@
 #         with npm ci into TMP once): its skinned meshes, joints, clip length,
 #         and the skin posed by three.js at 2 s against pose-export's own pose
 #         of frame 240 (LBS both).
+#   blender: the same replay imported by Blender's glTF importer (headless):
+#         one armature, the meshes bound to it, the action's length, the skin
+#         at 2 s against frame 240. Blender is not in scripts/deps (large).
 #   pvd:  a ParaView series of the same replay's first second, every frame
 #         read back with meshio (python3-meshio) with the expected counts.
-# Exits 77 (skipped, with the reason) when node/npm or meshio is missing.
-# usage: export_session.sh gltf|pvd POSE_EXPORT RIG SOURCE_DIR TMP
+# Exits 77 (skipped, with the reason) when node/npm, blender or meshio is missing.
+# usage: export_session.sh gltf|blender|pvd POSE_EXPORT RIG SOURCE_DIR TMP
 set -euo pipefail
 kind=$1 export_bin=$2 rig=$3 src=$4 tmp=$5
 clip="$src/data/mocap/cmu-bvh/01_01.bvh"
@@ -19,6 +22,18 @@ mkdir -p "$tmp"
 rm -rf "$tmp/$kind"
 mkdir -p "$tmp/$kind"
 json() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])" "$@"; }
+# The 4 s walk as an animated glTF, and pose-export's own pose of its frame 240 (2 s), both LBS.
+walk() {
+  "$export_bin" "$rig" --method lbs --source "$clip" --map "$map" --frames 0-480:12 \
+    --gltf-anim "$tmp/$kind/walk.glb" --json >"$tmp/$kind/session.json"
+  "$export_bin" "$rig" --method lbs --source "$clip" --map "$map" --frame 240 \
+    --glb "$tmp/$kind/frame240.glb" --json >"$tmp/$kind/frame.json"
+  cat "$tmp/$kind/session.json"
+  [ "$(json "$tmp/$kind/session.json" frames)" = 41 ] || { echo "expected 41 frames"; exit 1; }
+  meshes=$(json "$tmp/$kind/session.json" skinned_meshes)
+  [ "$meshes" -gt 1 ] || { echo "expected skin and bones, got $meshes skinned meshes"; exit 1; }
+  ls -l "$tmp/$kind/walk.glb" "$tmp/$kind/frame240.glb"
+}
 
 case $kind in
 gltf)
@@ -40,17 +55,21 @@ gltf)
     fi
   fi
   cp "$src/tests/examples/gltf/check_glb.mjs" "$node_dir/"
-  "$export_bin" "$rig" --method lbs --source "$clip" --map "$map" --frames 0-480:12 \
-    --gltf-anim "$tmp/gltf/walk.glb" --json >"$tmp/gltf/session.json"
-  "$export_bin" "$rig" --method lbs --source "$clip" --map "$map" --frame 240 \
-    --glb "$tmp/gltf/frame240.glb" --json >"$tmp/gltf/frame.json"
-  cat "$tmp/gltf/session.json"
-  [ "$(json "$tmp/gltf/session.json" frames)" = 41 ] || { echo "expected 41 frames"; exit 1; }
-  meshes=$(json "$tmp/gltf/session.json" skinned_meshes)
-  [ "$meshes" -gt 1 ] || { echo "expected skin and bones, got $meshes skinned meshes"; exit 1; }
-  ls -l "$tmp/gltf/walk.glb" "$tmp/gltf/frame240.glb"
+  walk
   # 19 joints in the full-body template; mean skin distance within 5 mm of pose-export's pose
   node "$node_dir/check_glb.mjs" "$tmp/gltf/walk.glb" "$meshes" 19 4.0 "$tmp/gltf/frame240.glb" 2.0 skin 0.005
+  ;;
+blender)
+  if ! command -v blender >/dev/null; then
+    echo "export_session blender: skipped: blender is not installed (apt-get install --no-install-recommends blender)"
+    exit 77
+  fi
+  walk
+  rc=0
+  timeout 200 blender -b --factory-startup --python-exit-code 1 --python "$src/tests/examples/gltf/check_blender.py" -- \
+    "$tmp/blender/walk.glb" "$meshes" 19 4.0 "$tmp/blender/frame240.glb" 2.0 0.005 >"$tmp/blender/blender.log" 2>&1 || rc=$?
+  grep -v '^Read \|^$' "$tmp/blender/blender.log" | tail -n 20
+  [ "$rc" = 0 ] || { echo "export_session blender: the check failed (blender exit $rc)"; exit 1; }
   ;;
 pvd)
   py=""
