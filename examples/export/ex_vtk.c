@@ -241,6 +241,19 @@ int ex_vtk_series_add(ex_vtk_series *s, const pose_state *st, double t_s, char *
     return 0;
 }
 
+/* s as XML attribute text. */
+static void put_xml(FILE *f, const char *s)
+{
+    for (; *s; s++)
+        switch (*s) {
+        case '&': fputs("&amp;", f); break;
+        case '<': fputs("&lt;", f); break;
+        case '>': fputs("&gt;", f); break;
+        case '"': fputs("&quot;", f); break;
+        default: fputc(*s, f);
+        }
+}
+
 int ex_vtk_series_finish(ex_vtk_series *s, char *err, size_t err_size)
 {
     FILE *f = fopen(s->pvd, "wb");
@@ -250,9 +263,11 @@ int ex_vtk_series_finish(ex_vtk_series *s, char *err, size_t err_size)
     }
     fprintf(f, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
                "<Collection>\n");
-    for (size_t i = 0; i < s->frames; i++)
-        fprintf(f, "<DataSet timestep=\"%.6f\" group=\"\" part=\"0\" file=\"%s_%05zu.vtu\"/>\n", s->times[i], s->base,
-                i);
+    for (size_t i = 0; i < s->frames; i++) {
+        fprintf(f, "<DataSet timestep=\"%.6f\" group=\"\" part=\"0\" file=\"", s->times[i]);
+        put_xml(f, s->base);
+        fprintf(f, "_%05zu.vtu\"/>\n", i);
+    }
     fprintf(f, "</Collection>\n</VTKFile>\n");
     int bad = ferror(f);
     if (fclose(f) != 0 || bad) {
