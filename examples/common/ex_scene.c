@@ -280,6 +280,8 @@ int ex_parse_method(const char *s)
         return POSE_DQS;
     if (!strcasecmp(s, "cor"))
         return POSE_COR;
+    if (!strcasecmp(s, "fem"))
+        return POSE_FEM;
     return -1;
 }
 
@@ -289,6 +291,7 @@ const char *ex_method_name(pose_method m)
     case POSE_LBS: return "LBS";
     case POSE_DQS: return "DQS";
     case POSE_COR: return "CoR";
+    case POSE_FEM: return "FEM";
     }
     return "?";
 }

@@ -31,7 +31,7 @@ static void usage(FILE *f)
           "  --frames A-B:STEP       clip frames of --source to export (or a list: 0,30,60)\n"
           "  --times T0-T1:STEP      seconds of the source's recorded time instead (or a list: 0,2.5)\n"
           "  --map FILE              the bridge mapping file for --source\n"
-          "  --method lbs|dqs|cor    skinning method (default: cor when the rig has CoR data)\n"
+          "  --method lbs|dqs|cor|fem skinning method (default: cor when the rig has CoR data)\n"
           "  --obj FILE              all tissues into one Wavefront OBJ (one object per tissue)\n"
           "  --ply DIR               one binary PLY per tissue, with normals\n"
           "  --vtu FILE              the posed tet mesh (VTK XML) with labels, displacement, weights\n"
@@ -137,7 +137,7 @@ int main(int argc, char **argv)
             break;
         case OPT_METHOD:
             if ((method = ex_parse_method(cli.value)) < 0) {
-                pose_cli_error(&cli, "--method: expected lbs, dqs or cor, got '%s'", cli.value);
+                pose_cli_error(&cli, "--method: expected lbs, dqs, cor or fem, got '%s'", cli.value);
                 return 2;
             }
             break;

@@ -23,11 +23,13 @@ void ex_render_usage(FILE *f)
           "                               LIST as 0,2.5,5 or 0-10:0.5 (HID and CAN recordings, clips)\n"
           "  --map FILE                   the bridge mapping file for --source\n"
           "  --turntable N                N images around the model\n"
-          "  --compare                    one image: LBS | DQS | CoR side by side, same pose (of\n"
-          "                               --pose, or of one --frames frame or --times time of --source)\n"
+          "  --compare                    one image: LBS | DQS | CoR (| FEM where the rig has its data)\n"
+          "                               side by side, same pose (of --pose, or of one --frames frame\n"
+          "                               or --times time of --source)\n"
           "Pose and look:\n"
           "  --pose JOINT=RX,RY,RZ        set a joint (degrees, XYZ order; repeatable)\n"
-          "  --method lbs|dqs|cor         skinning method (default: cor when the rig has CoR data)\n"
+          "  --method lbs|dqs|cor|fem     skinning method (default: cor when the rig has CoR data;\n"
+          "                               fem: CoR refined by quasi-static FEM, rigs with fem data)\n"
           "  --skin auto|translucent|opaque|hidden   (default auto: translucent over other tissues)\n"
           "  --hide KINDS                 hide tissue kinds: skin,bone,muscle,organ,other\n"
           "  --weights JOINT              colour the tet mesh by this joint's skinning weight\n"
@@ -185,7 +187,7 @@ int ex_render_parse(int argc, char **argv, ex_render_options *o, char *err, size
             break;
         case OPT_METHOD:
             if ((o->method = ex_parse_method(v)) < 0) {
-                snprintf(err, err_size, "--method: expected lbs, dqs or cor, got '%s'", v);
+                snprintf(err, err_size, "--method: expected lbs, dqs, cor or fem, got '%s'", v);
                 return -1;
             }
             break;
@@ -274,7 +276,7 @@ int ex_render_parse(int argc, char **argv, ex_render_options *o, char *err, size
                  o->width, o->height);
         return -1;
     }
-    if ((long)o->width * o->height * o->supersample * o->supersample * (o->compare ? 3 : 1) > 64L << 20) {
+    if ((long)o->width * o->height * o->supersample * o->supersample * (o->compare ? 4 : 1) > 64L << 20) {
         snprintf(err, err_size, "image too large: reduce --size or --supersample");
         return -1;
     }

@@ -318,21 +318,23 @@ static int frame_camera(job *jb)
     return 0;
 }
 
-/* LBS | DQS | CoR side by side, one pose (a rig without CoR data says so in its panel). */
+/* LBS | DQS | CoR side by side, one pose (a rig without CoR data says so in its panel),
+ * and FEM beside them when the rig has its data. */
 static int render_compare(job *jb)
 {
-    static const pose_method methods[3] = {POSE_LBS, POSE_DQS, POSE_COR};
+    static const pose_method methods[4] = {POSE_LBS, POSE_DQS, POSE_COR, POSE_FEM};
+    const int count = pose_rig_has_fem(jb->sc.rig) ? 4 : 3;
     const ex_render_options *o = jb->o;
     ex_image panel = {0};
     double apply = 0.0, t0 = ex_now();
     int rc = -1;
     if (jb->motion && set_pick(jb, 0) < 0)
         return -1;
-    if (ex_image_init(&panel, 3 * o->width, o->height, bg8) < 0) {
+    if (ex_image_init(&panel, count * o->width, o->height, bg8) < 0) {
         snprintf(jb->err, jb->err_size, "out of memory");
         return -1;
     }
-    for (int m = 0; m < 3; m++) {
+    for (int m = 0; m < count; m++) {
         char label[64];
         if (pose_set_method(jb->sc.state, methods[m]) < 0) {
             ex_image_fill(&jb->img, bg8);
@@ -350,7 +352,7 @@ static int render_compare(job *jb)
         ex_image_blit(&panel, &jb->img, m * o->width, 0);
     }
     caption(&panel, o->caption);
-    rc = emit(jb->s, &panel, jb->out, -1, -1.0, "LBS|DQS|CoR", 1e3 * (ex_now() - t0), apply, jb->err, jb->err_size);
+    rc = emit(jb->s, &panel, jb->out, -1, -1.0, count == 4 ? "LBS|DQS|CoR|FEM" : "LBS|DQS|CoR", 1e3 * (ex_now() - t0), apply, jb->err, jb->err_size);
 done:
     ex_image_free(&panel);
     return rc;

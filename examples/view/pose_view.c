@@ -38,7 +38,7 @@ static void usage(FILE *f)
           "                          (.bvh, .amc), a hid-recorder file (.hid), /dev/hidrawN or\n"
           "                          hid:VID:PID, a candump log (.log) or a CAN interface (can0)\n"
           "  --map FILE              the bridge mapping file for --source (bridge/maps/)\n"
-          "  --method lbs|dqs|cor    initial skinning method (default: cor when the rig has CoR data)\n"
+          "  --method lbs|dqs|cor|fem initial skinning method (default: cor when the rig has CoR data)\n"
           "  --pose JOINT=RX,RY,RZ   initial joint angles (degrees; repeatable)\n"
           "  --size WxH              window size (default 1280x800)\n"
           "  --quit-after N          close after N frames and print the frame rate (smoke tests)\n"
@@ -352,7 +352,7 @@ int main(int argc, char **argv)
             break;
         case OPT_METHOD:
             if ((method = ex_parse_method(cli.value)) < 0) {
-                pose_cli_error(&cli, "--method: expected lbs, dqs or cor, got '%s'", cli.value);
+                pose_cli_error(&cli, "--method: expected lbs, dqs, cor or fem, got '%s'", cli.value);
                 return 2;
             }
             break;

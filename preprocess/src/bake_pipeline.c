@@ -292,11 +292,18 @@ static int write_rig(const pp_bake_options *o, bake_state *s, pp_bake_report *re
              pose_version_string(), t->name, o->template_path, o->skin_path, o->bone_count,
              (double)rep->voxel_mm, pp_tet_backend_name(o->backend), s->w.influences,
              s->tet.vertex_count, s->tet.tet_count, neutral);
+    /* POSE_FEM simulates the rig's own tets (bone labels rigid): all it
+     * needs stored is the soft tissue's material. */
+    const pose_fem_material fem = {
+        (float)PP_BAKE_FEM_YOUNG,
+        (float)(o->fem_poisson > 0.0 ? o->fem_poisson : PP_BAKE_FEM_POISSON),
+        (float)PP_BAKE_FEM_DENSITY};
     pose_rig_desc desc = {t->joint_count,     s->joints,     s->tet.vertex_count,
                           s->tet.positions,   s->tet.tet_count, s->tet.tets,
                           s->tet.labels,      s->w.influences, s->w.joints,
                           s->w.weights,       s->cor,        rep->tissue_count,
-                          s->tissues,         meta,          s->clinical};
+                          s->tissues,         meta,          s->clinical,
+                          o->no_fem ? NULL : &fem};
     /* Write beside the target, then rename: a reader never sees half a rig. */
     size_t len = strlen(o->output_path) + 32;
     char *tmp = malloc(len);

@@ -36,6 +36,15 @@ const char *pp_bake_stage_name(pp_bake_stage s);
 /** Default voxel edge when neither resolution nor a vertex budget is given. */
 #define PP_BAKE_DEFAULT_RESOLUTION_MM 6.0
 
+/** Soft tissue of the fem section (POSE_FEM). Without gravity the
+ *  quasi-static refinement does not depend on Young's modulus, only on
+ *  Poisson's ratio: near 0.5 keeps volume, but slows CG (conditioning goes
+ *  with lambda / mu = 2 nu / (1 - 2 nu)). Young's modulus and density are
+ *  those of relaxed muscle and fat (~10 kPa, water's density). */
+#define PP_BAKE_FEM_YOUNG 10e3
+#define PP_BAKE_FEM_POISSON 0.48
+#define PP_BAKE_FEM_DENSITY 1000.0
+
 typedef struct pp_bake_options {
     const char *skin_path;
     const char *const *bone_paths; /**< bone mesh files; each mesh's name is its file stem */
@@ -52,6 +61,8 @@ typedef struct pp_bake_options {
     int threads;                    /**< 0 = 1 */
     int no_cor;                     /**< skip CoR (rig without the CoR method) */
     double cor_step;                /**< CoR weight-bin step (pp_cor_options.tolerance) */
+    int no_fem;                     /**< write no fem section (rig without POSE_FEM) */
+    double fem_poisson;             /**< soft tissue's Poisson ratio; 0: PP_BAKE_FEM_POISSON */
     /** Called at each stage's start (fraction_done of the whole bake) and end. */
     void (*progress)(pp_bake_stage stage, int finished, double fraction_done, void *user);
     void *user;

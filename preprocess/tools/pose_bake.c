@@ -23,6 +23,7 @@ static void usage(FILE *f)
             "usage: pose-bake --skin SKIN --bones DIR|FILE... --template TEMPLATE.json -o OUT.rig\n"
             "                 [--organs DIR|FILE...] [--resolution MM | --target-vertices N]\n"
             "                 [--backend lattice|tetgen] [-K N] [--threads N] [--no-cor] [--cor-step S]\n"
+            "                 [--no-fem] [--fem-poisson NU]\n"
             "                 [--vtu FILE] [--json] [--report FILE] [--quiet]\n"
             "\n"
             "Builds a rig for the pose runtime: fits the template's joints to the bones,\n"
@@ -43,12 +44,14 @@ static void usage(FILE *f)
             "  --no-cor               skip centres of rotation\n"
             "  --cor-step S           CoR weight-bin step (default 1/128; smaller is closer to\n"
             "                         the direct formula and slower: 1/256 ~ 4x)\n"
+            "  --no-fem               no fem section (the rig then has no POSE_FEM)\n"
+            "  --fem-poisson NU       soft tissue's Poisson ratio for POSE_FEM (default %.2f)\n"
             "  --vtu FILE             also write the tet mesh, labels and weights for ParaView\n"
             "  --json                 print the report as JSON on stdout\n"
             "  --report FILE          write the JSON report to FILE\n"
             "  --quiet                no progress line\n"
             "  --help, --version\n",
-            PP_BAKE_DEFAULT_RESOLUTION_MM);
+            PP_BAKE_DEFAULT_RESOLUTION_MM, PP_BAKE_FEM_POISSON);
 }
 
 typedef struct path_list {
@@ -224,6 +227,7 @@ int main(int argc, char **argv)
     o.threads = cores > 0 ? (int)cores : 1;
     enum { OPT_BONES = POSE_CLI_LONG_ONLY, OPT_ORGANS, OPT_SKIN, OPT_TEMPLATE, OPT_VTU, OPT_REPORT,
            OPT_RESOLUTION, OPT_TARGET_VERTICES, OPT_BACKEND, OPT_THREADS, OPT_COR_STEP, OPT_NO_COR,
+           OPT_NO_FEM, OPT_FEM_POISSON,
            OPT_JSON, OPT_QUIET, OPT_VERSION };
     static const struct option options[] = {
         {"skin", required_argument, NULL, OPT_SKIN},
@@ -238,6 +242,8 @@ int main(int argc, char **argv)
         {"threads", required_argument, NULL, OPT_THREADS},
         {"cor-step", required_argument, NULL, OPT_COR_STEP},
         {"no-cor", no_argument, NULL, OPT_NO_COR},
+        {"no-fem", no_argument, NULL, OPT_NO_FEM},
+        {"fem-poisson", required_argument, NULL, OPT_FEM_POISSON},
         {"vtu", required_argument, NULL, OPT_VTU},
         {"json", no_argument, NULL, OPT_JSON},
         {"report", required_argument, NULL, OPT_REPORT},
@@ -325,6 +331,14 @@ int main(int argc, char **argv)
             break;
         case OPT_NO_COR:
             o.no_cor = 1;
+            break;
+        case OPT_NO_FEM:
+            o.no_fem = 1;
+            break;
+        case OPT_FEM_POISSON:
+            if (pose_cli_double(&cli, 0.0, 0.4999, &d) < 0)
+                goto out;
+            o.fem_poisson = d;
             break;
         case OPT_JSON:
             json = 1;

@@ -16,13 +16,15 @@ const char *pose__section_name(uint32_t type)
     case POSE__SEC_METADATA: return "metadata";
     case POSE__SEC_VOLUMES: return "volumes";
     case POSE__SEC_CLINICAL: return "clinical";
+    case POSE__SEC_FEM: return "fem";
     default: return "unknown";
     }
 }
 
 bool pose__section_known(uint32_t type)
 {
-    return (type >= POSE__SEC_SKELETON && type <= POSE__SEC_METADATA) || type == POSE__SEC_CLINICAL;
+    return (type >= POSE__SEC_SKELETON && type <= POSE__SEC_METADATA) || type == POSE__SEC_CLINICAL ||
+           type == POSE__SEC_FEM;
 }
 
 pose__skeleton_layout pose__skeleton_layout_of(uint64_t joints)

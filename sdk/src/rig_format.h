@@ -57,7 +57,8 @@ typedef enum pose__section_type {
     POSE__SEC_TISSUES = 5,
     POSE__SEC_METADATA = 6,
     POSE__SEC_VOLUMES = 7, /* reserved for volumetric models */
-    POSE__SEC_CLINICAL = 8 /* neutral posture, clinical axes and ranges per joint */
+    POSE__SEC_CLINICAL = 8, /* neutral posture, clinical axes and ranges per joint */
+    POSE__SEC_FEM = 9       /* soft tissue material for POSE_FEM */
 } pose__section_type;
 
 /** Printable name of a section type ("skeleton", ...; "unknown" otherwise). */
@@ -89,6 +90,9 @@ pose__weights_layout pose__weights_layout_of(uint64_t vertices, uint64_t influen
 uint64_t pose__cor_size_of(uint64_t vertices);
 uint64_t pose__metadata_size_of(uint64_t length);
 uint64_t pose__clinical_size_of(uint64_t joints);
+/** The fem section: header, then one 64-byte material record (soft tissue). */
+#define POSE__RIG_FEM_RECORD 64u
+#define POSE__RIG_FEM_SIZE (POSE__RIG_SECTION_HEADER + POSE__RIG_FEM_RECORD)
 /** Bytes one tissue's arrays take (positions, triangles, tet, bary, each padded). */
 uint64_t pose__tissue_data_size(uint64_t vertices, uint64_t triangles);
 

@@ -46,6 +46,17 @@ typedef struct pose__clinical_record {
 } pose__clinical_record;
 _Static_assert(sizeof(pose__clinical_record) == 192, "clinical record is 192 bytes on disk");
 
+/** The soft tissue's material as stored in the optional `fem` section (64
+ *  bytes, little-endian; docs/rig-format.md). */
+typedef struct pose__fem_record {
+    float young;          /* Pa, finite, > 0 */
+    float poisson;        /* [0, 0.5) */
+    float density;        /* kg per cubic rig unit, finite, >= 0 */
+    uint32_t flags;       /* 0 */
+    uint8_t reserved[48]; /* zero */
+} pose__fem_record;
+_Static_assert(sizeof(pose__fem_record) == 64, "fem record is 64 bytes on disk");
+
 /** One tissue surface; arrays point into the rig's storage. */
 typedef struct pose__tissue {
     const char *name;         /* NUL-terminated, < POSE__NAME_SIZE bytes */
@@ -77,6 +88,7 @@ struct pose_rig {
     const pose_transform *joint_rest_local;/* relative to parent (= rest_model for roots) */
     const pose__joint_limit *joint_limits;
     const pose__clinical_record *clinical; /* joint_count records, or NULL (no section) */
+    const pose__fem_record *fem;           /* soft tissue material, or NULL (no POSE_FEM) */
 
     /* ---- tet mesh */
     size_t tet_vertex_count;

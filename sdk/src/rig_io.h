@@ -58,5 +58,7 @@ pose_status pose__rig_open(uint8_t *image, size_t size, pose__rig_storage storag
 pose_status pose__rig_validate(const pose_rig *rig, const pose__source *src);
 /** The `clinical` section's records (rig_clinical.c); a no-op without one. */
 pose_status pose__clinical_validate(const pose_rig *rig, const pose__source *src);
+/** The fem section's material record (when present): finite, in range. */
+pose_status pose__fem_validate(const pose_rig *rig, const pose__source *src);
 
 #endif /* POSE_RIG_IO_H */

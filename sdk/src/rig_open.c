@@ -359,6 +359,26 @@ static pose_status map_clinical(const pose__source *src, const entry *s, pose_ri
     return POSE_OK;
 }
 
+/* One material record (soft tissue); its values are checked by rig_fem.c. */
+static pose_status map_fem(const pose__source *src, const entry *s, pose_rig *rig)
+{
+    const uint8_t *p = src->base + s->offset;
+    pose_status st = need_header(src, s);
+    if (st != POSE_OK)
+        return st;
+    uint32_t classes = get_u32(p);
+    if (classes != 1)
+        return pose__source_fail(src, POSE_ERR_INVALID_DATA, "fem", p,
+                                 "%u material classes, this library reads 1 (soft tissue)", classes);
+    if (!all_zero(p + 4, POSE__RIG_SECTION_HEADER - 4))
+        return pose__source_fail(src, POSE_ERR_FORMAT, "fem", p + 4,
+                                 "reserved header bytes are not zero");
+    if (s->size != POSE__RIG_FEM_SIZE)
+        return size_mismatch(src, s, POSE__RIG_FEM_SIZE, "one material record");
+    rig->fem = (const pose__fem_record *)(const void *)(p + POSE__RIG_SECTION_HEADER);
+    return POSE_OK;
+}
+
 /* Tissue records hold counts and offsets; the offsets must follow the one
  * canonical layout, which rules out overlaps and misalignment at once. */
 static pose_status map_tissues(const pose__source *src, const entry *s, pose_rig *rig,
@@ -444,6 +464,8 @@ static pose_status map_sections(const pose__source *src, const entry *e, uint32_
         st = map_metadata(src, find(e, n, POSE__SEC_METADATA), rig);
     if (st == POSE_OK && find(e, n, POSE__SEC_CLINICAL))
         st = map_clinical(src, find(e, n, POSE__SEC_CLINICAL), rig);
+    if (st == POSE_OK && find(e, n, POSE__SEC_FEM))
+        st = map_fem(src, find(e, n, POSE__SEC_FEM), rig);
     if (st != POSE_OK)
         return st;
 

@@ -148,6 +148,40 @@ static void build_fans(const pose_rig *rig, const size_t *tissue_offset, uint32_
     fan_offset[0] = 0;
 }
 
+/* The simulation mesh of POSE_FEM is the rig's own tet mesh: bone tets are
+ * rigid (their vertices held), soft tets take the fem section's material.
+ * Its vertices are the skinned ones, so nothing needs embedding. */
+static pose_status prepare_fem(pose_rig *rig)
+{
+    if (!rig->fem)
+        return POSE_OK;
+    size_t size = pose__fem_mesh_size(rig->tet_vertex_count, rig->tet_count, rig->tets,
+                                      rig->tet_labels);
+    if (size == 0)
+        return pose__fail(POSE_ERR_UNSUPPORTED, "fem: tet mesh too large for 32-bit corner indices");
+    void *block = pose__alloc(&rig->allocator, size, POSE__ALIGN);
+    if (!block)
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY,
+                          "out of memory for the simulation mesh (%zu bytes)", size);
+    pose__fem_material m = {rig->fem->young, rig->fem->poisson, rig->fem->density};
+    pose__fem_mesh_build(rig->tet_vertex_count, rig->tet_positions, rig->tet_count, rig->tets,
+                         rig->tet_labels, &m, block, &rig->rt->fem);
+    rig->rt->fem_block = block;
+    /* The body's volume is held through its closed skin (fem_mesh.h). */
+    for (size_t t = 0; t < rig->tissue_count; t++) {
+        const pose__tissue *ts = &rig->tissues[t];
+        if (ts->kind != POSE_TISSUE_SKIN || ts->triangle_count == 0)
+            continue;
+        pose__fem_surface s = {
+            .vertex_count = ts->vertex_count, .triangle_count = ts->triangle_count,
+            .tets = rig->tets, .tet = ts->tet, .bary = ts->bary, .triangles = ts->triangles,
+        };
+        pose__fem_mesh_set_surface(&rig->rt->fem, &s, rig->tet_positions);
+        break;
+    }
+    return POSE_OK;
+}
+
 pose_status pose__rig_prepare(pose_rig *rig)
 {
     rig->rt = NULL;
@@ -282,11 +316,13 @@ pose_status pose__rig_prepare(pose_rig *rig)
         memcpy(rt->rest_model[j].t, rig->joint_rest_model[j].translation, sizeof(float) * 3);
     }
     rig->rt = rt;
-    return POSE_OK;
+    return prepare_fem(rig);
 }
 
 void pose__rig_release(pose_rig *rig)
 {
+    if (rig->rt && rig->rt->fem_block)
+        pose__free(&rig->allocator, rig->rt->fem_block);
     if (rig->rt)
         pose__free(&rig->allocator, rig->rt->block);
     rig->rt = NULL;

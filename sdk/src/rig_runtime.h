@@ -6,6 +6,7 @@
 
 #include <stddef.h>
 
+#include "fem_mesh.h"
 #include "rt_quat.h"
 #include "rt_skin.h"
 #include "rt_transfer.h"
@@ -26,6 +27,10 @@ struct pose__rig_runtime {
     float *rest_normals;     /**< 3 * total tissue vertices, area-weighted, unit (0 if none) */
     pose__xform *rest_model; /**< joint frames at rest, as runtime transforms */
     void *block;             /**< the one allocation holding all of the above */
+    /** POSE_FEM's simulation mesh (rigs with a fem section): the rig's own
+     *  tets, in its own allocation (fem_block, NULL without one). */
+    pose__fem_mesh fem;
+    void *fem_block;
 };
 
 #endif /* POSE_RIG_RUNTIME_H */

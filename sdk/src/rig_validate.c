@@ -238,6 +238,8 @@ pose_status pose__rig_validate(const pose_rig *rig, const pose__source *src)
         st = check_tissues(rig, src, refs);
     if (st == POSE_OK)
         st = pose__clinical_validate(rig, src);
+    if (st == POSE_OK)
+        st = pose__fem_validate(rig, src);
     pose__free(&rig->allocator, refs);
     return st;
 }

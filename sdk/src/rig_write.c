@@ -190,6 +190,17 @@ static void write_clinical(uint8_t *s, const pose_rig_desc *d)
     }
 }
 
+static void write_fem(uint8_t *s, const pose_rig_desc *d)
+{
+    put_u32(s, 1); /* one material class: soft tissue */
+    pose__fem_record r;
+    memset(&r, 0, sizeof r);
+    r.young = d->fem->young_modulus;
+    r.poisson = d->fem->poisson_ratio;
+    r.density = d->fem->density;
+    memcpy(s + POSE__RIG_SECTION_HEADER, &r, sizeof r);
+}
+
 static void write_tissues(uint8_t *s, const pose_rig_desc *d)
 {
     put_u32(s, (uint32_t)d->tissue_count);
@@ -226,7 +237,7 @@ pose_status pose__rig_serialize(const pose_rig_desc *d, const pose_allocator *al
         return st;
     size_t meta_len = d->metadata ? strlen(d->metadata) : 0;
 
-    section_plan plan[7];
+    section_plan plan[8];
     uint32_t n = 0;
     plan[n++] = (section_plan){POSE__SEC_SKELETON, 0, pose__skeleton_layout_of(d->joint_count).size};
     plan[n++] = (section_plan){POSE__SEC_TETMESH, 0,
@@ -240,6 +251,8 @@ pose_status pose__rig_serialize(const pose_rig_desc *d, const pose_allocator *al
         plan[n++] = (section_plan){POSE__SEC_METADATA, 0, pose__metadata_size_of(meta_len)};
     if (d->clinical)
         plan[n++] = (section_plan){POSE__SEC_CLINICAL, 0, pose__clinical_size_of(d->joint_count)};
+    if (d->fem)
+        plan[n++] = (section_plan){POSE__SEC_FEM, 0, POSE__RIG_FEM_SIZE};
 
     uint64_t total = POSE__RIG_HEADER_SIZE + pose__align64((uint64_t)n * POSE__RIG_ENTRY_SIZE);
     for (uint32_t i = 0; i < n; i++) {
@@ -263,6 +276,7 @@ pose_status pose__rig_serialize(const pose_rig_desc *d, const pose_allocator *al
         case POSE__SEC_COR: write_cor(s, d); break;
         case POSE__SEC_TISSUES: write_tissues(s, d); break;
         case POSE__SEC_CLINICAL: write_clinical(s, d); break;
+        case POSE__SEC_FEM: write_fem(s, d); break;
         case POSE__SEC_METADATA:
             put_u64(s, meta_len);
             memcpy(s + POSE__RIG_SECTION_HEADER, d->metadata, meta_len);
@@ -271,7 +285,7 @@ pose_status pose__rig_serialize(const pose_rig_desc *d, const pose_allocator *al
         uint8_t *e = img + POSE__RIG_HEADER_SIZE + i * POSE__RIG_ENTRY_SIZE;
         put_u32(e + POSE__ENT_TYPE, plan[i].type);
         /* Readers before pose 0.2 skip what they do not know only when it is optional. */
-        if (plan[i].type == POSE__SEC_CLINICAL)
+        if (plan[i].type == POSE__SEC_CLINICAL || plan[i].type == POSE__SEC_FEM)
             put_u32(e + POSE__ENT_FLAGS, POSE__SECTION_OPTIONAL);
         put_u64(e + POSE__ENT_OFFSET, plan[i].offset);
         put_u64(e + POSE__ENT_SIZE, plan[i].size);

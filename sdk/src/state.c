@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* pose_state: creation, threads, method, pose_apply and its outputs. */
+#include <stdbool.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -49,8 +50,12 @@ static size_t st_blocks(const pose_rig *rig)
 
 static pose_status check_method(const pose_rig *rig, pose_method method)
 {
-    if ((int)method < POSE_LBS || (int)method > POSE_COR)
+    if ((int)method < POSE_LBS || (int)method > POSE_FEM)
         return pose__fail(POSE_ERR_INVALID_ARGUMENT, "unknown skinning method %d", (int)method);
+    if (method == POSE_FEM && !pose_rig_has_fem(rig))
+        return pose__fail(POSE_ERR_UNSUPPORTED,
+                          "POSE_FEM needs the rig's fem section (soft tissue material), and "
+                          "this rig has none");
     if (method == POSE_COR && !rig->cor)
         return pose__fail(POSE_ERR_UNSUPPORTED,
                           "POSE_COR needs centres of rotation, and this rig has none");
@@ -119,7 +124,9 @@ pose_status pose_state_create_ex(const pose_rig *rig, const pose_state_options *
     size_t off_flagged = off_nrm + align64(3 * nt * sizeof(float));
     const size_t nt_padded = st_blocks(rig) * POSE__BLOCK;
     size_t off_counts = off_flagged + align64(nt_padded * sizeof(uint32_t));
-    size_t size = off_counts + align64(POSE__MAX_THREADS * sizeof(size_t));
+    size_t off_fem = off_counts + align64(POSE__MAX_THREADS * sizeof(size_t));
+    const bool fem = pose_rig_has_fem(rig);
+    size_t size = off_fem + (fem ? align64(pose__fem_work_size(&rig->rt->fem)) : 0);
 
     pose_allocator alloc = pose__allocator_resolve(&opt.allocator);
     unsigned char *block = pose__alloc(&alloc, size, POSE__ALIGN);
@@ -144,6 +151,9 @@ pose_status pose_state_create_ex(const pose_rig *rig, const pose_state_options *
     st->tissue_normals = (float *)(block + off_nrm);
     st->flagged = (uint32_t *)(block + off_flagged);
     st->flagged_count = (size_t *)(block + off_counts);
+    if (fem)
+        pose__fem_work_init(&rig->rt->fem, block + off_fem, &st->fem_work);
+    pose__state_fem_defaults(&st->fem_params);
     for (size_t j = 0; j < nj; j++)
         pose__quat_identity(st->local[j]);
     pose__state_rig_ranges(st);
@@ -209,16 +219,16 @@ pose_status pose_set_threads(pose_state *st, int threads)
 /* The two parallel passes of pose_apply, split into whole blocks of 8
  * vertices by part: every vertex is computed on its own, so results do not
  * depend on the thread count. */
-static void skin_task(void *ctx, unsigned part, unsigned parts)
+void pose__state_skin_task(void *ctx, unsigned part, unsigned parts)
 {
     pose_state *st = ctx;
     const pose__skin_mesh *mesh = &st->rt->skin;
     size_t b = pose__part_begin(mesh->block_count, part, parts);
     size_t e = pose__part_begin(mesh->block_count, part + 1, parts);
-    pose__skin((int)st->method, mesh, st->palette, b, e, st->tet_positions);
+    pose__skin(pose__state_skin_method(st), mesh, st->palette, b, e, st->tet_positions);
 }
 
-static void transfer_task(void *ctx, unsigned part, unsigned parts)
+void pose__state_transfer_task(void *ctx, unsigned part, unsigned parts)
 {
     pose_state *st = ctx;
     const pose__transfer_mesh *mesh = &st->rt->transfer;
@@ -230,7 +240,7 @@ static void transfer_task(void *ctx, unsigned part, unsigned parts)
 
 /* Normals of the vertices in flat or inverted tets, from their triangles:
  * needs every position, hence a pass of its own. */
-static void fix_normals_task(void *ctx, unsigned part, unsigned parts)
+void pose__state_fix_normals_task(void *ctx, unsigned part, unsigned parts)
 {
     pose_state *st = ctx;
     const pose__transfer_mesh *mesh = &st->rt->transfer;
@@ -251,26 +261,38 @@ pose_status pose_apply(pose_state *st)
     /* Small meshes run on the caller alone: waking workers would cost more
      * than the work (results are the same either way). */
     const size_t blocks = st->rt->skin.block_count + st->rt->transfer.block_count;
-    if (blocks < POSE__SERIAL_BLOCKS) {
-        skin_task(st, 0, 1);
-        transfer_task(st, 0, 1);
-        if (st->flagged_count[0] > 0)
-            fix_normals_task(st, 0, 1);
-        return POSE_OK;
+    const bool serial = blocks < POSE__SERIAL_BLOCKS;
+    double t0 = st->method == POSE_FEM ? pose__seconds() : 0.0;
+    if (serial)
+        pose__state_skin_task(st, 0, 1);
+    else
+        pose__pool_run(st->pool, pose__state_skin_task, st);
+    if (st->method == POSE_FEM) {
+        double t1 = pose__seconds();
+        st->fem_stats.seconds_skin = t1 - t0;
+        pose__state_fem_refine(st); /* state_fem.c */
+        t0 = pose__seconds();
     }
-    pose__pool_run(st->pool, skin_task, st);
-    pose__pool_run(st->pool, transfer_task, st);
-    size_t flagged = 0;
-    for (unsigned p = 0; p < pose__pool_threads(st->pool); p++)
-        flagged += st->flagged_count[p];
-    if (flagged > 0)
-        pose__pool_run(st->pool, fix_normals_task, st);
+    if (serial) {
+        pose__state_transfer_task(st, 0, 1);
+        if (st->flagged_count[0] > 0)
+            pose__state_fix_normals_task(st, 0, 1);
+    } else {
+        pose__pool_run(st->pool, pose__state_transfer_task, st);
+        size_t flagged = 0;
+        for (unsigned p = 0; p < pose__pool_threads(st->pool); p++)
+            flagged += st->flagged_count[p];
+        if (flagged > 0)
+            pose__pool_run(st->pool, pose__state_fix_normals_task, st);
+    }
+    if (st->method == POSE_FEM)
+        st->fem_stats.seconds_transfer = pose__seconds() - t0;
     return POSE_OK;
 }
 
 size_t pose__state_frame_bytes(const pose_state *st)
 {
-    return pose__skin_bytes((int)st->method, &st->rt->skin) +
+    return pose__skin_bytes(pose__state_skin_method(st), &st->rt->skin) +
            pose__transfer_bytes(&st->rt->transfer, st->rig->tet_vertex_count, 1);
 }
 

@@ -9,6 +9,7 @@
 #include <stdint.h>
 
 #include "clinical_math.h"
+#include "fem_solve.h"
 #include "pose/pose.h"
 #include "rig_internal.h"
 #include "rig_runtime.h"
@@ -39,6 +40,11 @@ struct pose_state {
                                      this frame; part p lists from its first vertex */
     size_t *flagged_count;      /**< per part (POSE__MAX_THREADS) */
 
+    /* POSE_FEM (state_fem.c); work arrays only when the rig has a fem section */
+    pose__fem_work fem_work;
+    pose__fem_params fem_params;
+    pose_fem_stats fem_stats;
+
     pose__pool *pool;           /**< own allocation: replaced by pose_set_threads */
     void *block;                /**< the allocation holding everything else */
 };
@@ -54,6 +60,19 @@ struct pose_state {
 /** Bytes pose_apply must move per frame with the state's method: every
  *  array the kernels stream, read or written once (benchmarks). */
 size_t pose__state_frame_bytes(const pose_state *st);
+
+/** The skinning kernel a method runs (POSE_FEM skins with CoR, else DQS). */
+int pose__state_skin_method(const pose_state *st);
+/** pose_apply's passes (ctx: the state; part of parts). */
+void pose__state_skin_task(void *ctx, unsigned part, unsigned parts);
+void pose__state_transfer_task(void *ctx, unsigned part, unsigned parts);
+void pose__state_fix_normals_task(void *ctx, unsigned part, unsigned parts);
+/** Monotonic clock, seconds (FEM statistics). */
+double pose__seconds(void);
+/** Default FEM solver settings. */
+void pose__state_fem_defaults(pose__fem_params *out);
+/** pose_apply's FEM refinement of st->tet_positions (after skinning). */
+void pose__state_fem_refine(pose_state *st);
 
 /** Joint rotation setters' shared tail: clamp q to joint j's limits, store it. */
 pose_status pose__state_store_joint(pose_state *st, int joint, float q[4]);

@@ -138,6 +138,8 @@ typedef enum pose_method {
     POSE_LBS = 0, /**< linear blend skinning */
     POSE_DQS = 1, /**< dual quaternion skinning (antipodality handled) */
     POSE_COR = 2, /**< optimized centres of rotation (needs CoR data in the rig) */
+    POSE_FEM = 3, /**< CoR (DQS without CoR data) refined by quasi-static co-rotational
+                       FEM (needs the rig's fem section; see pose_fem_options) @since 0.2 */
 } pose_method;
 
 /** What a tissue surface is. */
@@ -427,6 +429,9 @@ typedef struct pose_rig_desc {
      *  posture and no clinical axes (pose_rig_joint_clinical says
      *  POSE_ERR_UNSUPPORTED). Stored in the optional `clinical` section. @since 0.2 */
     const struct pose_joint_clinical *clinical;
+    /** Soft tissue's material, or NULL: the rig then has no POSE_FEM. Stored
+     *  in the optional `fem` section. @since 0.2 */
+    const struct pose_fem_material *fem;
 } pose_rig_desc;
 
 /**
@@ -566,6 +571,66 @@ POSE_API const float *pose_tissue_normals(const pose_state *state, int tissue, s
 POSE_API const float *pose_tet_positions(const pose_state *state, size_t *vertex_count);
 /** Joint frame in model space after the last pose_apply. @since 0.1 */
 POSE_API pose_status pose_joint_world(const pose_state *state, int joint, pose_transform *out);
+
+/* ------------------------------------------ physically based layer (FEM) */
+
+/**
+ * POSE_FEM (design §2, Sujar et al. §5): the tet mesh is skinned (CoR, or
+ * DQS when the rig has no centres), then refined to the steady state of
+ * linear co-rotational elasticity: every vertex of a bone tet (label > 0)
+ * is held where skinning put it (bones are rigid), the soft tissue
+ * (label 0) moves to its elastic equilibrium, and the tissues follow by the
+ * usual transfer. The simulation mesh is the rig's own tet mesh; the rig's
+ * `fem` section gives the soft tissue's material. Near-incompressible
+ * tissue (Poisson's ratio 0.45-0.49) keeps the body's volume where
+ * skinning inflates or deflates it.
+ *
+ * Each outer iteration takes every tet's rotation from its deformation
+ * (polar decomposition, started from the state's last rotations) and solves
+ * the warped linear system by Jacobi-preconditioned conjugate gradients. The
+ * result is identical for any thread count; it depends on the state's
+ * previous poses only through where the rotations start (differences far
+ * below the tolerance). pose_apply still allocates nothing.
+ */
+
+/** The soft tissue's linear isotropic material (pose_rig_desc.fem). */
+typedef struct pose_fem_material {
+    float young_modulus; /**< Pa, > 0 (soft tissue: a few kPa) */
+    float poisson_ratio; /**< [0, 0.5); near 0.5 keeps volume */
+    float density;       /**< kg per cubic rig unit, >= 0 (gravity only) */
+} pose_fem_material;
+
+/** Solver settings; zero fields take the defaults. size: as pose_load_options. */
+typedef struct pose_fem_options {
+    size_t size;          /**< sizeof(pose_fem_options), or 0 */
+    int outer_iterations; /**< co-rotational updates (default 4) */
+    int cg_iterations;    /**< most CG iterations per outer iteration (default 200) */
+    float tolerance;      /**< stop when the residual force is this fraction of the
+                               skinned pose's (default 0.01) */
+    float gravity[3];     /**< rig units / s^2 (default 0: no sag) */
+} pose_fem_options;
+
+/** What the last pose_apply with POSE_FEM did. */
+typedef struct pose_fem_stats {
+    size_t size;             /**< sizeof(pose_fem_stats), set by the caller */
+    int outer_iterations;
+    int cg_iterations;       /**< summed over the outer iterations */
+    double residual;         /**< final residual force / the skinned pose's */
+    double seconds_skin;     /**< skinning of the tet mesh */
+    double seconds_rotations;/**< polar decompositions and elastic forces */
+    double seconds_cg;       /**< conjugate gradient iterations */
+    double seconds_transfer; /**< transfer to the tissues */
+} pose_fem_stats;
+
+/** Whether the rig has what POSE_FEM needs (its `fem` section). @since 0.2 */
+POSE_API int pose_rig_has_fem(const pose_rig *rig);
+/** The soft tissue's material; POSE_ERR_UNSUPPORTED without a fem section. @since 0.2 */
+POSE_API pose_status pose_rig_fem_material(const pose_rig *rig, pose_fem_material *out);
+/** Set the solver settings (NULL: defaults). POSE_ERR_INVALID_ARGUMENT for
+ *  negative counts or a tolerance outside [0, 1). @since 0.2 */
+POSE_API pose_status pose_set_fem_options(pose_state *state, const pose_fem_options *options);
+/** Statistics of the last FEM refinement (zeros before one); out->size must be set. @since 0.2 */
+POSE_API pose_status pose_get_fem_stats(const pose_state *state, pose_fem_stats *out);
 
 /* ---------------------------------------------------------------- bounds */
 

@@ -1,0 +1,151 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/*
+ * bench_fem: POSE_FEM on a baked body (pose-bake with the full_body
+ * template), per posture of issue 12: skin volume change of CoR (DQS
+ * without centres) and of FEM against rest, the time of pose_apply with
+ * each (ratio measured in the same run), and where the FEM frame goes:
+ * skinning, rotations + elastic forces, CG iterations, transfer. The state
+ * is posed from rest each repetition and fresh per posture, so every run
+ * refines from the skinned pose (the rotations start from the previous
+ * repetition's: as in an animation).
+ *
+ *   fem RIG [--threads N] [--reps N] [--tolerance T] [--outer N]
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bench_common.h"
+#include "fem_volume.h"
+#include "pose/pose.h"
+
+typedef struct posture {
+    const char *name;
+    const char *joints[2];
+    float deg[3];
+} posture;
+
+static const posture k_postures[] = {
+    {"shoulder flexion 150", {"shoulder_r", "shoulder_l"}, {150, 0, 0}},
+    {"arms at the sides", {"shoulder_r", "shoulder_l"}, {0, 0, 0}},
+    {"hip flexion 90", {"hip_r", "hip_l"}, {90, 0, 0}},
+    {"knee flexion 120", {"knee_r", "knee_l"}, {120, 0, 0}},
+    {"elbow flexion 120", {"elbow_r", "elbow_l"}, {120, 0, 0}},
+};
+
+static int set_posture(const pose_rig *rig, pose_state *st, const posture *p)
+{
+    pose_reset(st);
+    for (int s = 0; s < 2; s++) {
+        int j = pose_rig_find_joint(rig, p->joints[s]);
+        if (j < 0 || pose_set_joint_clinical(st, j, p->deg) < 0) {
+            fprintf(stderr, "fem: %s: %s\n", p->joints[s], pose_last_error());
+            return -1;
+        }
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2 || !strcmp(argv[1], "--help")) {
+        fprintf(stderr, "usage: fem RIG [--threads N] [--reps N] [--tolerance T] [--outer N]\n");
+        return argc < 2 ? 2 : 0;
+    }
+    int threads = 2, reps = 5, outer = 0;
+    float tol = 0.0f;
+    for (int i = 2; i + 1 < argc; i += 2) {
+        if (!strcmp(argv[i], "--threads"))
+            threads = atoi(argv[i + 1]);
+        else if (!strcmp(argv[i], "--reps"))
+            reps = atoi(argv[i + 1]);
+        else if (!strcmp(argv[i], "--tolerance"))
+            tol = (float)atof(argv[i + 1]);
+        else if (!strcmp(argv[i], "--outer"))
+            outer = atoi(argv[i + 1]);
+        else {
+            fprintf(stderr, "fem: unknown option %s\n", argv[i]);
+            return 2;
+        }
+    }
+    pose_rig *rig;
+    if (pose_rig_load(argv[1], &rig) != POSE_OK) {
+        fprintf(stderr, "fem: %s\n", pose_last_error());
+        return 1;
+    }
+    if (!pose_rig_has_fem(rig)) {
+        fprintf(stderr, "fem: %s has no fem section (bake without --no-fem)\n", argv[1]);
+        return 1;
+    }
+    int skin = -1;
+    for (size_t t = 0; t < pose_rig_tissue_count(rig) && skin < 0; t++) {
+        pose_tissue_info ti;
+        pose_rig_tissue_info(rig, (int)t, &ti);
+        if (ti.kind == POSE_TISSUE_SKIN)
+            skin = (int)t;
+    }
+    pose_tissue_info si;
+    pose_tet_info tet;
+    pose_rig_tissue_info(rig, skin, &si);
+    pose_rig_tet_info(rig, &tet);
+    const double v0 = fx_mesh_volume(si.rest_positions, si.triangles, si.triangle_count);
+    const pose_method skinning = tet.cor ? POSE_COR : POSE_DQS;
+    size_t soft = 0;
+    for (size_t t = 0; t < tet.tet_count; t++)
+        soft += tet.labels[t] == 0;
+    printf("rig %s: %zu tet vertices, %zu tets (%zu soft), skin %.3f L; %d threads, %d reps\n",
+           argv[1], tet.vertex_count, tet.tet_count, soft, v0 * 1e3, threads, reps);
+    printf("%-22s %9s %8s %9s %8s %6s %5s %7s %7s %7s %7s %7s %6s\n", "posture",
+           skinning == POSE_COR ? "CoR dV%" : "DQS dV%", "ms", "FEM dV%", "ms", "outer", "CG",
+           "skin", "rot", "cg", "xfer", "ms/CG", "ratio");
+    pose_state_options so = {.size = sizeof so, .threads = threads};
+    double worst = 0.0, slowest = 0.0;
+    for (size_t p = 0; p < sizeof k_postures / sizeof k_postures[0]; p++) {
+        pose_state *sk, *fem;
+        if (pose_state_create_ex(rig, &so, &sk) || pose_state_create_ex(rig, &so, &fem)) {
+            fprintf(stderr, "fem: %s\n", pose_last_error());
+            return 1;
+        }
+        pose_set_method(sk, skinning);
+        pose_set_method(fem, POSE_FEM);
+        pose_fem_options fo = {.size = sizeof fo, .outer_iterations = outer, .tolerance = tol};
+        pose_set_fem_options(fem, &fo);
+        double t_sk = 0.0, t_fem = 0.0;
+        pose_fem_stats sum = {0}, fs = {.size = sizeof fs};
+        for (int r = 0; r < reps; r++) {
+            if (set_posture(rig, sk, &k_postures[p]) || set_posture(rig, fem, &k_postures[p]))
+                return 1;
+            double t0 = bench_now();
+            pose_apply(sk);
+            double t1 = bench_now();
+            pose_apply(fem);
+            double t2 = bench_now();
+            t_sk += t1 - t0;
+            t_fem += t2 - t1;
+            pose_get_fem_stats(fem, &fs);
+            sum.seconds_skin += fs.seconds_skin;
+            sum.seconds_rotations += fs.seconds_rotations;
+            sum.seconds_cg += fs.seconds_cg;
+            sum.seconds_transfer += fs.seconds_transfer;
+            sum.cg_iterations += fs.cg_iterations;
+        }
+        double vs = fx_mesh_volume(pose_tissue_positions(sk, skin, NULL), si.triangles, si.triangle_count);
+        double vf = fx_mesh_volume(pose_tissue_positions(fem, skin, NULL), si.triangles, si.triangle_count);
+        double ms = 1e3 / reps;
+        printf("%-22s %+9.3f %8.2f %+9.3f %8.2f %6d %5d %7.2f %7.2f %7.2f %7.2f %7.3f %6.1f\n",
+               k_postures[p].name, 100 * (vs - v0) / v0, t_sk * ms, 100 * (vf - v0) / v0,
+               t_fem * ms, fs.outer_iterations, fs.cg_iterations, sum.seconds_skin * ms,
+               sum.seconds_rotations * ms, sum.seconds_cg * ms, sum.seconds_transfer * ms,
+               sum.cg_iterations ? 1e3 * sum.seconds_cg / sum.cg_iterations : 0.0,
+               t_fem / t_sk);
+        worst = fmax(worst, fabs(vf - v0) / v0);
+        slowest = fmax(slowest, t_fem * ms);
+        pose_state_free(sk);
+        pose_state_free(fem);
+    }
+    printf("FEM: largest |dV| %.3f %% (target 0.3 %%), slowest posture %.2f ms (target 50 ms)\n",
+           100 * worst, slowest);
+    pose_rig_free(rig);
+    return 0;
+}

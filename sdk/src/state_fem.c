@@ -1,0 +1,91 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* POSE_FEM on a state: solver settings, statistics, and the refinement
+ * pose_apply runs between skinning and transfer. */
+#include <math.h>
+#include <string.h>
+#include <time.h>
+
+#include "error.h"
+#include "state_internal.h"
+
+double pose__seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+int pose__state_skin_method(const pose_state *st)
+{
+    if (st->method != POSE_FEM)
+        return (int)st->method;
+    /* Refinement starts from the best skinning the rig allows: the closer
+     * the start, the fewer iterations (CoR already keeps most volume). */
+    return st->rig->cor ? POSE__SKIN_COR : POSE__SKIN_DQS;
+}
+
+void pose__state_fem_defaults(pose__fem_params *out)
+{
+    *out = (pose__fem_params){.outer_iterations = 4, .cg_iterations = 200, .tolerance = 0.01f};
+}
+
+pose_status pose_set_fem_options(pose_state *st, const pose_fem_options *o)
+{
+    pose__clear_error();
+    if (!st)
+        return pose__fail(POSE_ERR_INVALID_ARGUMENT, "pose_set_fem_options: state is NULL");
+    pose__fem_params p;
+    pose__state_fem_defaults(&p);
+    if (o) {
+        if (o->size != 0 && o->size < sizeof(pose_fem_options))
+            return pose__fail(POSE_ERR_INVALID_ARGUMENT,
+                              "pose_set_fem_options: options.size %zu is below the 0.2 layout (%zu)",
+                              o->size, sizeof(pose_fem_options));
+        if (o->outer_iterations < 0 || o->cg_iterations < 0)
+            return pose__fail(POSE_ERR_INVALID_ARGUMENT,
+                              "pose_set_fem_options: iteration counts must be >= 0 (%d, %d)",
+                              o->outer_iterations, o->cg_iterations);
+        if (!(o->tolerance >= 0.0f && o->tolerance < 1.0f))
+            return pose__fail(POSE_ERR_INVALID_ARGUMENT,
+                              "pose_set_fem_options: tolerance %g is not in [0, 1)",
+                              (double)o->tolerance);
+        for (int a = 0; a < 3; a++)
+            if (!isfinite(o->gravity[a]))
+                return pose__fail(POSE_ERR_INVALID_ARGUMENT,
+                                  "pose_set_fem_options: gravity is not finite");
+        if (o->outer_iterations)
+            p.outer_iterations = o->outer_iterations;
+        if (o->cg_iterations)
+            p.cg_iterations = o->cg_iterations;
+        if (o->tolerance > 0.0f)
+            p.tolerance = o->tolerance;
+        memcpy(p.gravity, o->gravity, sizeof p.gravity);
+    }
+    st->fem_params = p;
+    return POSE_OK;
+}
+
+pose_status pose_get_fem_stats(const pose_state *st, pose_fem_stats *out)
+{
+    pose__clear_error();
+    if (!st || !out)
+        return pose__fail(POSE_ERR_INVALID_ARGUMENT, "pose_get_fem_stats: state and out are required");
+    if (out->size < sizeof(pose_fem_stats))
+        return pose__fail(POSE_ERR_INVALID_ARGUMENT,
+                          "pose_get_fem_stats: out->size %zu is below the 0.2 layout (%zu)",
+                          out->size, sizeof(pose_fem_stats));
+    *out = st->fem_stats;
+    out->size = sizeof(pose_fem_stats);
+    return POSE_OK;
+}
+
+void pose__state_fem_refine(pose_state *st)
+{
+    pose__fem_stats s;
+    pose__fem_solve(&st->rt->fem, &st->fem_work, st->pool, &st->fem_params, st->tet_positions, &s);
+    st->fem_stats.outer_iterations = s.outer_iterations;
+    st->fem_stats.cg_iterations = s.cg_iterations;
+    st->fem_stats.residual = s.residual;
+    st->fem_stats.seconds_rotations = s.seconds_rotations;
+    st->fem_stats.seconds_cg = s.seconds_cg;
+}

@@ -1,0 +1,251 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* POSE_FEM on the body baked from the bundled anatomy (full_body template):
+ * skin volume against rest at the issue's five postures, CoR vs FEM
+ * (|dV| <= 0.3 % with FEM); bones rigid; the same result for any thread
+ * count. The rig comes from the fem_body_bake fixture (POSE_FEM_RIG). */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "fem_volume.h"
+#include "pose/pose.h"
+
+typedef struct posture {
+    const char *name;
+    const char *joints[2];
+    float deg[3];
+} posture;
+
+/* Both sides, clinical angles; every other joint stays at rest (the
+ * T-pose the body was scanned in). Arms at the sides: the shoulders'
+ * neutral posture. */
+static const posture k_postures[] = {
+    {"shoulder flexion 150", {"shoulder_r", "shoulder_l"}, {150, 0, 0}},
+    {"arms at the sides", {"shoulder_r", "shoulder_l"}, {0, 0, 0}},
+    {"hip flexion 90", {"hip_r", "hip_l"}, {90, 0, 0}},
+    {"knee flexion 120", {"knee_r", "knee_l"}, {120, 0, 0}},
+    {"elbow flexion 120", {"elbow_r", "elbow_l"}, {120, 0, 0}},
+};
+#define POSTURES (sizeof k_postures / sizeof k_postures[0])
+
+static pose_rig *g_rig;
+static int g_skin = -1;
+static double g_rest_volume;
+
+static void set_posture(pose_state *st, const posture *p)
+{
+    assert_int_equal(pose_reset(st), POSE_OK);
+    for (int s = 0; s < 2; s++) {
+        int j = pose_rig_find_joint(g_rig, p->joints[s]);
+        assert_true(j >= 0);
+        assert_true(pose_set_joint_clinical(st, j, p->deg) >= 0);
+    }
+}
+
+static double skin_volume(const pose_state *st)
+{
+    pose_tissue_info info;
+    assert_int_equal(pose_rig_tissue_info(g_rig, g_skin, &info), POSE_OK);
+    size_t n;
+    const float *pos = pose_tissue_positions(st, g_skin, &n);
+    return fx_mesh_volume(pos, info.triangles, info.triangle_count);
+}
+
+static int setup(void **state)
+{
+    (void)state;
+    const char *path = getenv("POSE_FEM_RIG");
+    if (!path || pose_rig_load(path, &g_rig) != POSE_OK) {
+        fprintf(stderr, "cannot load POSE_FEM_RIG=%s: %s\n", path ? path : "(unset)",
+                pose_last_error());
+        return -1;
+    }
+    for (size_t t = 0; t < pose_rig_tissue_count(g_rig); t++) {
+        pose_tissue_info info;
+        pose_rig_tissue_info(g_rig, (int)t, &info);
+        if (info.kind == POSE_TISSUE_SKIN)
+            g_skin = (int)t;
+    }
+    if (g_skin < 0)
+        return -1;
+    pose_tissue_info info;
+    pose_rig_tissue_info(g_rig, g_skin, &info);
+    g_rest_volume = fx_mesh_volume(info.rest_positions, info.triangles, info.triangle_count);
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    pose_rig_free(g_rig);
+    return 0;
+}
+
+/* Skin volume at each posture: FEM within 0.3 % of rest. Skinning's
+ * changes are printed beside it (what the refinement corrects). */
+static void test_volume(void **state)
+{
+    (void)state;
+    assert_true(pose_rig_has_fem(g_rig));
+    pose_tet_info tet;
+    assert_int_equal(pose_rig_tet_info(g_rig, &tet), POSE_OK);
+    const pose_method skinning = tet.cor ? POSE_COR : POSE_DQS;
+    pose_state_options so = {.size = sizeof so, .threads = 2};
+    pose_state *sk, *fem;
+    assert_int_equal(pose_state_create_ex(g_rig, &so, &sk), POSE_OK);
+    assert_int_equal(pose_state_create_ex(g_rig, &so, &fem), POSE_OK);
+    assert_int_equal(pose_set_method(sk, skinning), POSE_OK);
+    assert_int_equal(pose_set_method(fem, POSE_FEM), POSE_OK);
+    printf("skin at rest: %.3f L; %zu tet vertices, %zu tets\n", g_rest_volume * 1e3,
+           tet.vertex_count, tet.tet_count);
+    double worst = 0.0;
+    for (size_t i = 0; i < POSTURES; i++) {
+        set_posture(sk, &k_postures[i]);
+        set_posture(fem, &k_postures[i]);
+        assert_int_equal(pose_apply(sk), POSE_OK);
+        assert_int_equal(pose_apply(fem), POSE_OK);
+        double vs = skin_volume(sk), vf = skin_volume(fem);
+        double ds = (vs - g_rest_volume) / g_rest_volume, df = (vf - g_rest_volume) / g_rest_volume;
+        pose_fem_stats fs = {.size = sizeof fs};
+        assert_int_equal(pose_get_fem_stats(fem, &fs), POSE_OK);
+        printf("%-22s %s %+7.3f L (%+6.2f %%)   FEM %+7.3f L (%+6.2f %%)   %d outer, %d CG, "
+               "residual %.3g\n",
+               k_postures[i].name, skinning == POSE_COR ? "CoR" : "DQS",
+               (vs - g_rest_volume) * 1e3, 100 * ds, (vf - g_rest_volume) * 1e3, 100 * df,
+               fs.outer_iterations, fs.cg_iterations, fs.residual);
+        if (fabs(df) > worst)
+            worst = fabs(df);
+    }
+    printf("largest FEM volume change: %.3f %%\n", 100 * worst);
+    assert_true(worst <= 0.003);
+    pose_state_free(sk);
+    pose_state_free(fem);
+}
+
+/* Joint j's rigid motion applied to rest point p. */
+static void rigid(const pose_transform *rest, const pose_transform *world, const float *p, double out[3])
+{
+    const float qi[4] = {-rest->rotation[0], -rest->rotation[1], -rest->rotation[2],
+                         rest->rotation[3]};
+    double d[3] = {(double)p[0] - rest->translation[0], (double)p[1] - rest->translation[1],
+                   (double)p[2] - rest->translation[2]};
+    double l[3];
+    fx_rotate(qi, d, l);
+    fx_rotate(world->rotation, l, out);
+    for (int a = 0; a < 3; a++)
+        out[a] += world->translation[a];
+}
+
+/* Bones are rigid: every vertex of one bone's tets (not shared with
+ * another bone's) stays within 0.1 mm of the bone's rigid motion
+ * (the joint's world frame times the inverse of its rest frame). The bone
+ * surfaces, embedded partly in soft tets, are printed beside it. */
+static void test_bones_rigid(void **state)
+{
+    (void)state;
+    pose_tet_info tet;
+    assert_int_equal(pose_rig_tet_info(g_rig, &tet), POSE_OK);
+    /* per vertex: the bone label of its bone tets; 0 none, -1 two bones
+     * (skinning blends those, as any method does) */
+    int *bone = calloc(tet.vertex_count, sizeof(int));
+    assert_non_null(bone);
+    for (size_t t = 0; t < tet.tet_count; t++)
+        for (int c = 0; c < 4 && tet.labels[t] > 0; c++) {
+            int *b = &bone[tet.tets[4 * t + (size_t)c]];
+            int l = tet.labels[t];
+            *b = *b == 0 ? l : (*b != l ? -1 : *b);
+        }
+    pose_state *st;
+    assert_int_equal(pose_state_create(g_rig, &st), POSE_OK);
+    assert_int_equal(pose_set_method(st, POSE_FEM), POSE_OK);
+    size_t nj = pose_rig_joint_count(g_rig);
+    pose_joint_info *ji = calloc(nj, sizeof *ji);
+    pose_transform *w = calloc(nj, sizeof *w);
+    assert_true(ji && w);
+    for (size_t j = 0; j < nj; j++)
+        assert_int_equal(pose_rig_joint_info(g_rig, (int)j, &ji[j]), POSE_OK);
+    double worst = 0.0, surface = 0.0;
+    size_t held = 0;
+    for (size_t i = 0; i < POSTURES; i++) {
+        set_posture(st, &k_postures[i]);
+        assert_int_equal(pose_apply(st), POSE_OK);
+        for (size_t j = 0; j < nj; j++)
+            assert_int_equal(pose_joint_world(st, (int)j, &w[j]), POSE_OK);
+        const float *x = pose_tet_positions(st, NULL);
+        for (size_t v = 0; v < tet.vertex_count; v++) {
+            if (bone[v] <= 0)
+                continue;
+            size_t j = (size_t)bone[v] - 1;
+            double r[3];
+            rigid(&ji[j].rest_model, &w[j], tet.rest_positions + 3 * v, r);
+            double e = sqrt((r[0] - x[3 * v]) * (r[0] - x[3 * v]) + (r[1] - x[3 * v + 1]) * (r[1] - x[3 * v + 1]) +
+                            (r[2] - x[3 * v + 2]) * (r[2] - x[3 * v + 2]));
+            if (e > worst)
+                worst = e;
+            held += i == 0;
+        }
+        for (size_t t = 0; t < pose_rig_tissue_count(g_rig); t++) {
+            pose_tissue_info info;
+            pose_rig_tissue_info(g_rig, (int)t, &info);
+            if (info.kind != POSE_TISSUE_BONE || info.joint < 0)
+                continue;
+            double d = fx_rigid_deviation(&ji[info.joint].rest_model, &w[info.joint],
+                                          info.rest_positions, pose_tissue_positions(st, (int)t, NULL),
+                                          info.vertex_count);
+            if (d > surface)
+                surface = d;
+        }
+    }
+    printf("bones: %zu tet vertices of one bone's tets, largest deviation from its rigid motion "
+           "%.4f mm; bone surfaces (embedded partly in soft tets): %.2f mm\n",
+           held, worst * 1e3, surface * 1e3);
+    assert_true(held > 0);
+    assert_true(worst <= 1e-4);
+    free(ji);
+    free(w);
+    free(bone);
+    pose_state_free(st);
+}
+
+/* 1, 2 and 3 threads: the same bits. */
+static void test_threads(void **state)
+{
+    (void)state;
+    pose_tet_info tet;
+    assert_int_equal(pose_rig_tet_info(g_rig, &tet), POSE_OK);
+    float *ref = malloc(3 * tet.vertex_count * sizeof(float));
+    assert_non_null(ref);
+    for (int threads = 1; threads <= 3; threads++) {
+        pose_state_options so = {.size = sizeof so, .threads = threads, .method = POSE_FEM};
+        pose_state *st;
+        assert_int_equal(pose_state_create_ex(g_rig, &so, &st), POSE_OK);
+        set_posture(st, &k_postures[0]);
+        assert_int_equal(pose_apply(st), POSE_OK);
+        set_posture(st, &k_postures[4]);
+        assert_int_equal(pose_apply(st), POSE_OK);
+        const float *x = pose_tet_positions(st, NULL);
+        if (threads == 1)
+            memcpy(ref, x, 3 * tet.vertex_count * sizeof(float));
+        else
+            assert_memory_equal(ref, x, 3 * tet.vertex_count * sizeof(float));
+        pose_state_free(st);
+    }
+    free(ref);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_volume),
+        cmocka_unit_test(test_bones_rigid),
+        cmocka_unit_test(test_threads),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
