@@ -5,7 +5,8 @@
 # devices still build; live vendor-class devices report POSE_ERR_UNSUPPORTED.
 pkg_check_modules(LIBUSB IMPORTED_TARGET libusb-1.0)
 if(LIBUSB_FOUND)
-  pose_bridge_link(PkgConfig::LIBUSB)
+  # dl: hidapi's libusb backend is loaded at run time (usb_hid.c), beside the hidraw one the HID family links.
+  pose_bridge_link(PkgConfig::LIBUSB ${CMAKE_DL_LIBS})
   pose_bridge_define(POSE_BRIDGE_HAVE_LIBUSB=1)
   set(POSE_BRIDGE_HAVE_LIBUSB ON PARENT_SCOPE)
 else()

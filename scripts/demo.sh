@@ -111,7 +111,8 @@ pose_view=$(tool pose-view)
 frames_dir="$out/frames"
 hid_dir="$out/hid"
 can_dir="$out/can"
-rm -rf "$frames_dir" "$hid_dir" "$can_dir"
+usb_dir="$out/usb"
+rm -rf "$frames_dir" "$hid_dir" "$can_dir" "$usb_dir"
 mkdir -p "$frames_dir"
 
 # The full chain needs pose-bake and the bridge's replay; both are detected, not assumed.
@@ -222,6 +223,12 @@ else
         --caption "HID mannequin sit-to-stand" "${look[@]}" -o "$hid_dir" | tee -a "$log"
     "$render" "$rig" --source "$can_rec" --map "$can_map" --times 0.5,2.2,4,7 \
         --caption "CAN rig sit, stand, arms up" "${look[@]}" -o "$can_dir" | tee -a "$log"
+    # The vendor-class USB goniometer box's usbmon capture (data/usb), through the same bridge.
+    if [ "$kind" = body ] && [ -f "$root/data/usb/gonio_arm_raise.usbmon" ]; then
+        "$render" "$rig" --source "$root/data/usb/gonio_arm_raise.usbmon" \
+            --map "$root/bridge/maps/usb_gonio_full_body.json" --times 0.5,3.5,7.5 \
+            --caption "USB goniometer box arm raise" "${look[@]}" -o "$usb_dir" | tee -a "$log"
+    fi
 fi
 
 now=$(date +%s)
@@ -234,7 +241,7 @@ else
 fi
 find "$out" -maxdepth 1 -type f | sort | sed "s|^$out/|  |"
 echo "  frames/: $(find "$frames_dir" -name '*.png' | wc -l) PNG images"
-for d in "$hid_dir" "$can_dir"; do
+for d in "$hid_dir" "$can_dir" "$usb_dir"; do
     if [ -d "$d" ]; then echo "  $(basename "$d")/: $(find "$d" -name '*.png' | wc -l) PNG images"; fi
 done
 

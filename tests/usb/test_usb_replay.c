@@ -21,6 +21,7 @@
 #include <cmocka.h>
 
 #include "usb_gonio.h"
+#include "usb_hid.h"
 #include "usb_source.h"
 #include "usbmon.h"
 
@@ -274,6 +275,18 @@ static void test_specs_and_live(void **state)
     } else {
         print_message("live: %s\n", err.message);
         assert_true(s == POSE_ERR_UNSUPPORTED || s == POSE_ERR_IO);
+    }
+    /* HID over hidapi's libusb backend (loaded with dlmopen): a device that is not there is named */
+    s = pb_usb_hid_open("hidusb:1209:00fe", NULL, &src, &err);
+    print_message("hidusb: %s\n", err.message);
+    assert_null(src);
+    assert_true(s == POSE_ERR_NOT_FOUND || s == POSE_ERR_UNSUPPORTED || s == POSE_ERR_IO);
+    if (s == POSE_ERR_NOT_FOUND)
+        assert_non_null(strstr(err.message, "hidusb 1209:00fe: no such device plugged in"));
+    static const char *const bad_hid[] = {"hidusb:1209", "hidusb:1209:0002:x", "hidusb:12345:1", "hidusb:1209:0002:300"};
+    for (size_t i = 0; i < sizeof bad_hid / sizeof bad_hid[0]; i++) {
+        assert_int_equal(pb_usb_hid_open(bad_hid[i], NULL, &src, &err), POSE_ERR_INVALID_ARGUMENT);
+        assert_non_null(strstr(err.message, "expected hidusb:VID:PID[:INTERFACE]"));
     }
 }
 

@@ -33,6 +33,8 @@
  *   hid:VID:PID[:PAGE:USAGE]    live HID device (hex USB ids; optionally the top-level
  *                               collection's usage page and usage), through hidapi
  *   /dev/hidrawN                live HID device node
+ *   hidusb:VID:PID[:IFACE]      live HID device without a hidraw node, through hidapi's
+ *                               libusb backend (usbhid detached, containers)
  *   can:IFACE  or  IFACE        live SocketCAN interface (can0, vcan0 ...)
  *   usb:VID:PID[:SERIAL][/IF/EP]  live vendor-class USB device through libusb (hex ids,
  *                               decimal interface, hex IN endpoint)

@@ -7,6 +7,7 @@
 #if POSE_BRIDGE_HAVE_DEVICES
 #include "can_source.h"
 #include "hid_open.h"
+#include "usb_hid.h"
 #include "usb_source.h"
 #endif
 
@@ -49,7 +50,7 @@ pose_status pb_spec_parse(const char *source, pb_spec *out, pb_error *err)
         }
     }
     /* hid:VID:PID keeps its prefix: the HID opener parses the whole spec. */
-    if (after_prefix(source, "hid:") || after_prefix(source, "/dev/hidraw")) {
+    if (after_prefix(source, "hid:") || after_prefix(source, "/dev/hidraw") || after_prefix(source, "hidusb:")) {
         *out = (pb_spec){PB_SPEC_HID_LIVE, source};
         return POSE_OK;
     }
@@ -78,7 +79,7 @@ pose_status pb_spec_parse(const char *source, pb_spec *out, pb_error *err)
     }
     return pb_fail(err, POSE_ERR_INVALID_ARGUMENT,
                    "%s: unknown kind of source (expected a .bvh or .amc clip, a .hid hid-recorder file, "
-                   "a candump .log, a .usbmon capture, hid:VID:PID, /dev/hidrawN, usb:VID:PID, can:IFACE or an "
+                   "a candump .log, a .usbmon capture, hid:VID:PID, /dev/hidrawN, hidusb:VID:PID, usb:VID:PID, can:IFACE or an "
                    "interface name such as can0, or KIND:PATH with KIND bvh, amc, hid-recording, candump or usbmon)",
                    source);
 }
@@ -147,6 +148,8 @@ pose_status pb_spec_open_device(const pb_spec *spec, const pb_spec_open_options 
         return open_usb(spec, o, out, err);
     pb_hid_replay_options ho = {.source = {.stale_ms = o->stale_ms}, .speed = o->speed,
                                 .as_fast_as_possible = o->as_fast_as_possible, .loop = o->loop};
+    if (spec->kind == PB_SPEC_HID_LIVE && after_prefix(spec->target, "hidusb:"))
+        return pb_usb_hid_open(spec->target, &ho.source, out, err);
     if (spec->kind == PB_SPEC_HID_LIVE)
         return pb_hid_open(spec->target, &ho, out, err);
     return pb_hid_replay_open(spec->target, &ho, out, err);

@@ -16,7 +16,7 @@ typedef enum pb_spec_kind {
     PB_SPEC_BVH = 0,
     PB_SPEC_AMC = 1,
     PB_SPEC_HID_FILE = 2, /**< hid-recorder file */
-    PB_SPEC_HID_LIVE = 3, /**< hid:VID:PID[:PAGE:USAGE] or /dev/hidrawN */
+    PB_SPEC_HID_LIVE = 3, /**< hid:VID:PID[:PAGE:USAGE], /dev/hidrawN, or hidusb:VID:PID[:IFACE] (hidapi's libusb backend) */
     PB_SPEC_CANDUMP = 4,  /**< candump -l log */
     PB_SPEC_CAN_LIVE = 5, /**< SocketCAN interface */
     PB_SPEC_USBMON = 6,   /**< usbmon text capture of a vendor-class USB device */

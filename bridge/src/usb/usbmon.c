@@ -241,6 +241,9 @@ pose_status pb_usbmon_parse(const char *text, size_t len, const char *name, pb_u
             st = parse_line(&b, p, n, name, lineno, err);
         p = nl ? nl + 1 : end;
     }
+    /* data is never NULL, so that data + offset is a pointer even for a capture without data words */
+    if (st == POSE_OK && !b.c->data && grow((void **)&b.c->data, &b.data_cap, 1, 1) != 0)
+        st = pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
     if (st != POSE_OK) {
         pb_usbmon_capture_free(b.c);
         return st;
