@@ -348,14 +348,17 @@ uint32_t pb_usb_checksum(pb_usb_checksum_kind kind, const uint8_t *p, size_t n)
         for (size_t i = 0; i < n; i++)
             c ^= p[i];
         return c;
-    case PB_USB_CHECKSUM_CRC16_CCITT:
+    case PB_USB_CHECKSUM_CRC16_CCITT: {
+        /* a nibble at a time: nib[k] is the CRC (poly 0x1021) of k shifted in from the top */
+        static const uint16_t nib[16] = {0x0000, 0x1021, 0x2042, 0x3063, 0x4084, 0x50a5, 0x60c6, 0x70e7,
+                                         0x8108, 0x9129, 0xa14a, 0xb16b, 0xc18c, 0xd1ad, 0xe1ce, 0xf1ef};
         c = 0xFFFF;
         for (size_t i = 0; i < n; i++) {
-            c ^= (uint32_t)p[i] << 8;
-            for (int b = 0; b < 8; b++)
-                c = c & 0x8000 ? ((c << 1) ^ 0x1021) & 0xFFFF : (c << 1) & 0xFFFF;
+            c = ((c << 4) ^ nib[(c >> 12) ^ (p[i] >> 4)]) & 0xFFFF;
+            c = ((c << 4) ^ nib[(c >> 12) ^ (p[i] & 0x0F)]) & 0xFFFF;
         }
         return c;
+    }
     default:
         return 0;
     }
