@@ -44,8 +44,12 @@ static const char *map_prefix(const char *source)
     if (n > 4 && (strcmp(source + n - 4, ".bvh") == 0 || strcmp(source + n - 4, ".amc") == 0))
         return NULL; /* clips map joints by name without a mapping */
     if (strncmp(source, "hid:", 4) == 0 || strncmp(source, "hid-recording:", 14) == 0 ||
-        strncmp(source, "/dev/hidraw", 11) == 0 || (n > 4 && strcmp(source + n - 4, ".hid") == 0))
+        strncmp(source, "/dev/hidraw", 11) == 0 || strncmp(source, "hidusb:", 7) == 0 ||
+        (n > 4 && strcmp(source + n - 4, ".hid") == 0))
         return "hid_";
+    if (strncmp(source, "usb:", 4) == 0 || strncmp(source, "usbmon:", 7) == 0 ||
+        (n > 7 && strcmp(source + n - 7, ".usbmon") == 0))
+        return "usb_";
     if (strncmp(source, "can", 3) == 0 || strncmp(source, "vcan", 4) == 0 || strncmp(source, "candump:", 8) == 0 ||
         (n > 4 && strcmp(source + n - 4, ".log") == 0))
         return "can_";
@@ -59,11 +63,11 @@ void pb_cli_hint_maps(const char *source)
         return;
     char dir[PATH_MAX];
     if (pb_cli_maps_dir(dir, sizeof dir) < 0) {
-        fprintf(stderr, "hint: HID and CAN sources need --map MAP.json (pose's mappings are installed in "
+        fprintf(stderr, "hint: HID, CAN and USB sources need --map MAP.json (pose's mappings are installed in "
                         "share/pose/maps)\n");
         return;
     }
-    fprintf(stderr, "hint: HID and CAN sources need --map MAP.json; pose's mappings are in %s:", dir);
+    fprintf(stderr, "hint: HID, CAN and USB sources need --map MAP.json; pose's mappings are in %s:", dir);
     DIR *d = opendir(dir);
     for (struct dirent *e; d && (e = readdir(d));)
         if (strncmp(e->d_name, prefix, strlen(prefix)) == 0 && strstr(e->d_name, ".json"))

@@ -7,7 +7,9 @@
  * (3 reordered), a stall, babble, a wire error, a short transfer, 2 bad
  * checksums, and an unplug mid-transfer after which the device, back at
  * another address with its counter restarted, is reopened. Also: recorded
- * timing, seeking, source strings, the live opener without a device. */
+ * timing, seeking, source strings, the live opener without a device, and
+ * the source's hotplug path on a scripted transport: after the device
+ * leaves, no open is tried until the transport reports its arrival. */
 #include <errno.h>
 #include <math.h>
 #include <setjmp.h>
@@ -318,6 +320,110 @@ static void test_cut_capture(void **state)
     assert_non_null(strstr(err.message, "no completed interrupt IN transfer on endpoint 0x82"));
 }
 
+
+/* A scripted live transport: frames while plugged, gone at frame 5, arrival reported after 3 waits. */
+typedef struct fake {
+    pb_usb_transport base;
+    int plugged, opens, waits, reads, closes;
+} fake;
+
+static pose_status fake_open(pb_usb_transport *t, pb_error *err)
+{
+    fake *f = (fake *)t;
+    f->opens++;
+    return f->plugged ? POSE_OK : pb_fail(err, POSE_ERR_NOT_FOUND, "fake: not plugged in");
+}
+
+static int fake_read(pb_usb_transport *t, uint8_t *buf, size_t cap, int timeout_ms, pb_usb_completion *c)
+{
+    fake *f = (fake *)t;
+    (void)cap;
+    (void)timeout_ms;
+    if (++f->reads == 5) {
+        f->plugged = 0;
+        return PB_USB_READ_GONE; /* hotplug said it left */
+    }
+    uint8_t fr[PB_GONIO_FRAME_BYTES];
+    double deg[PB_MANNEQUIN_AXES] = {0};
+    deg[12] = f->reads; /* knee_l */
+    pb_gonio_pack(t->layout, deg, 0, (uint16_t)(f->reads > 5 ? f->reads - 6 : f->reads), NULL, fr);
+    memcpy(buf, fr, sizeof fr);
+    *c = (pb_usb_completion){PB_USB_XFER_OK, sizeof fr, pb_usb_now_ns()};
+    return 1;
+}
+
+static int fake_wait(pb_usb_transport *t, int timeout_ms)
+{
+    fake *f = (fake *)t;
+    (void)timeout_ms;
+    if (++f->waits < 3)
+        return 0;
+    f->plugged = 1;
+    return 1;
+}
+
+static void fake_close(pb_usb_transport *t)
+{
+    ((fake *)t)->closes++;
+}
+
+static void fake_destroy(pb_usb_transport *t)
+{
+    (void)t; /* on the test's stack */
+}
+
+static const pb_usb_transport_ops fake_ops = {"usb", fake_open, fake_read, NULL, fake_wait, fake_close, fake_destroy};
+
+typedef struct states {
+    char log[2048];
+} states;
+
+static void log_state(pb_source *src, pb_source_state st, const char *msg, void *user)
+{
+    states *s = user;
+    (void)src;
+    size_t n = strlen(s->log);
+    snprintf(s->log + n, sizeof s->log - n, "%s: %s\n", pb_source_state_name(st), msg);
+}
+
+static void test_hotplug_reopen(void **state)
+{
+    (void)state;
+    static pb_usb_layout l;
+    pb_gonio_layout(&l);
+    fake f = {.base = {.ops = &fake_ops, .origin = "usb:1209:0002", .hotplug = 1}, .plugged = 1};
+    pb_source *src;
+    pb_error err;
+    assert_int_equal(pb_usb_source_create(&f.base, &l, NULL, &src, &err), POSE_OK);
+    assert_string_equal(src->ops->kind, "usb");
+    states st = {{0}};
+    src->on_status = log_state;
+    src->on_status_user = &st;
+    pb_update u;
+    for (int i = 0; i < 4; i++)
+        assert_int_equal(pb_source_read(src, &u, 100), 1);
+    /* frame 5: gone; then 2 waits without arrival (no open tried), the third reports it: reopened, frames again */
+    assert_int_equal(pb_source_read(src, &u, 100), 1);
+    print_message("%s", st.log);
+    assert_int_equal(f.opens, 2);  /* the first open and the one after the arrival: no polling */
+    assert_int_equal(f.waits, 3);
+    assert_int_equal(f.closes, 1);
+    assert_non_null(strstr(st.log, "disconnected: usb:1209:0002: device disconnected; waiting for it to come back (hotplug)\n"
+                                   "waiting: usb:1209:0002: reopened on hotplug arrival\nok: usb:1209:0002: receiving\n"));
+    const pb_usb_frame_stats *s = pb_usb_source_stats(src);
+    assert_int_equal(s->disconnects, 1);
+    assert_int_equal(s->lost, 0); /* the counter restarted with the device: resynchronised, not a loss */
+    assert_int_equal(pb_usb_source_reopens(src), 1);
+    assert_true(fabs(u.values[12] - (1.025 * 6 + 4.1)) < 0.051); /* knee_l's sensor at 6 degrees */
+    pb_source_destroy(src);
+    /* not plugged in at open: DISCONNECTED at once, no error */
+    fake g = {.base = {.ops = &fake_ops, .origin = "usb:1209:0002", .hotplug = 1}, .plugged = 0};
+    assert_int_equal(pb_usb_source_create(&g.base, &l, NULL, &src, &err), POSE_OK);
+    assert_int_equal(src->state, PB_SOURCE_DISCONNECTED);
+    assert_string_equal(src->message, "fake: not plugged in");
+    pb_source_destroy(src);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -326,6 +432,7 @@ int main(void)
         cmocka_unit_test(test_timing_and_seek),
         cmocka_unit_test(test_specs_and_live),
         cmocka_unit_test(test_cut_capture),
+        cmocka_unit_test(test_hotplug_reopen),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

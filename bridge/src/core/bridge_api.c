@@ -143,7 +143,7 @@ static pose_status open_parts(pose_bridge *b, pb_error *err)
                        b->source);
     if (!clip && !b->map_path && !b->map_json)
         return pb_fail(err, POSE_ERR_INVALID_ARGUMENT,
-                       "%s: a HID or CAN source needs a mapping with \"channels\" (options.map_path or map_json)",
+                       "%s: a HID, CAN or USB source needs a mapping with \"channels\" (options.map_path or map_json)",
                        b->source);
     s = pb_rig_skel_from_rig(b->rig, &b->skel, err);
     if (s < 0)
