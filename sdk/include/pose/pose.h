@@ -603,10 +603,10 @@ typedef struct pose_fem_material {
 /** Solver settings; zero fields take the defaults. size: as pose_load_options. */
 typedef struct pose_fem_options {
     size_t size;          /**< sizeof(pose_fem_options), or 0 */
-    int outer_iterations; /**< co-rotational updates (default 4) */
+    int outer_iterations; /**< co-rotational updates (default 2) */
     int cg_iterations;    /**< most CG iterations per outer iteration (default 200) */
     float tolerance;      /**< stop when the residual force is this fraction of the
-                               skinned pose's (default 0.01) */
+                               skinned pose's (default 0.05) */
     float gravity[3];     /**< rig units / s^2 (default 0: no sag) */
 } pose_fem_options;
 
