@@ -11,9 +11,11 @@
 #         one armature, the meshes bound to it, the action's length, the skin
 #         at 2 s against frame 240. Blender is not in scripts/deps (large).
 #   pvd:  a ParaView series of the same replay's first second, every frame
-#         read back with meshio (python3-meshio) with the expected counts.
+#         read back with meshio (python3-meshio) with the expected counts,
+#         and one pose's --surfaces file.
+#   args: what the session options refuse, each named.
 # Exits 77 (skipped, with the reason) when node/npm, blender or meshio is missing.
-# usage: export_session.sh gltf|blender|pvd POSE_EXPORT RIG SOURCE_DIR TMP
+# usage: export_session.sh gltf|blender|pvd|args POSE_EXPORT RIG SOURCE_DIR TMP
 set -euo pipefail
 kind=$1 export_bin=$2 rig=$3 src=$4 tmp=$5
 clip="$src/data/mocap/cmu-bvh/01_01.bvh"
@@ -86,9 +88,34 @@ pvd)
   ls -l "$tmp/pvd"
   "$py" "$src/tests/examples/check_pvd.py" "$tmp/pvd/walk.pvd" 5 \
     "$(json "$tmp/pvd/session.json" tissue_vertices)" "$(json "$tmp/pvd/session.json" tissue_triangles)"
+  # one pose: the same surfaces in one file
+  "$export_bin" "$rig" --pose knee_r=0,60,0 --surfaces "$tmp/pvd/knee.vtu" >/dev/null
+  "$py" - "$tmp/pvd/knee.vtu" "$(json "$tmp/pvd/session.json" tissue_vertices)" <<'PY'
+import sys, meshio
+m = meshio.read(sys.argv[1])
+assert m.points.shape == (int(sys.argv[2]), 3), m.points.shape
+assert abs(m.point_data["displacement"]).max() > 0.05, "the knee did not move"
+print(f"{sys.argv[1]}: {m.points.shape[0]} points, tissues {int(m.cell_data['tissue'][0].max()) + 1}")
+PY
+  ;;
+args)
+  # refused: each line is an argument list and the message it must give (exit 2)
+  while IFS='|' read -r args want; do
+    out=$("$export_bin" "$rig" $args 2>&1) && { echo "accepted: $args"; exit 1; }
+    case $out in *"$want"*) ;; *) echo "pose-export $args: expected '$want', got: $out"; exit 1 ;; esac
+  done <<EOT
+--frames 0-10:5 --pvd $tmp/args/x.pvd|need --source
+--source $clip --frames 0-10:5 --obj $tmp/args/x.obj|the other outputs hold one pose
+--source $clip --frame 3 --pvd $tmp/args/x.pvd|give --source with --frames or --times
+--source $clip --frames 0-10:5 --times 0-1:0.5 --pvd $tmp/args/x.pvd|one of --frame, --frames, --times
+--source $clip --frames 10-0:5 --pvd $tmp/args/x.pvd|--frames
+--source $clip --map $map --frames 0-99999:5000 --gltf-anim $tmp/args/x.glb|out of range
+--source $clip --map $map --frames 0-10:5 --pvd $tmp/args/missing/x.pvd|cannot create
+EOT
+  echo "export_session args: 7 refusals, each named"
   ;;
 *)
-  echo "usage: $0 gltf|pvd POSE_EXPORT RIG SOURCE_DIR TMP" >&2
+  echo "usage: $0 gltf|blender|pvd|args POSE_EXPORT RIG SOURCE_DIR TMP" >&2
   exit 2
   ;;
 esac
