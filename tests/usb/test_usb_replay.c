@@ -19,6 +19,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include <cmocka.h>
 
@@ -325,12 +326,17 @@ static void test_cut_capture(void **state)
 typedef struct fake {
     pb_usb_transport base;
     int plugged, opens, waits, reads, closes;
+    int deny; /* opens to refuse after the arrival (udev not done yet) */
 } fake;
 
 static pose_status fake_open(pb_usb_transport *t, pb_error *err)
 {
     fake *f = (fake *)t;
     f->opens++;
+    if (f->plugged && f->deny > 0 && f->waits > 0) {
+        f->deny--;
+        return pb_fail(err, POSE_ERR_IO, "fake: found but not usable: Access denied");
+    }
     return f->plugged ? POSE_OK : pb_fail(err, POSE_ERR_NOT_FOUND, "fake: not plugged in");
 }
 
@@ -355,9 +361,12 @@ static int fake_read(pb_usb_transport *t, uint8_t *buf, size_t cap, int timeout_
 static int fake_wait(pb_usb_transport *t, int timeout_ms)
 {
     fake *f = (fake *)t;
-    (void)timeout_ms;
-    if (++f->waits < 3)
+    if (++f->waits != 3) { /* nothing arrives: the wait takes its time (5 ms at most here) */
+        int ms = timeout_ms < 5 ? timeout_ms : 5;
+        struct timespec ts = {0, (long)ms * 1000000};
+        nanosleep(&ts, NULL);
         return 0;
+    }
     f->plugged = 1;
     return 1;
 }
@@ -415,6 +424,22 @@ static void test_hotplug_reopen(void **state)
     assert_int_equal(s->lost, 0); /* the counter restarted with the device: resynchronised, not a loss */
     assert_int_equal(pb_usb_source_reopens(src), 1);
     assert_true(fabs(u.values[12] - (1.025 * 6 + 4.1)) < 0.051); /* knee_l's sensor at 6 degrees */
+    pb_source_destroy(src);
+    /* an arrival whose open fails (permissions not there yet) is retried every reopen_ms until it opens */
+    fake h = {.base = {.ops = &fake_ops, .origin = "usb:1209:0002", .hotplug = 1}, .plugged = 1, .deny = 2};
+    pb_usb_source_options o = {.reopen_ms = 20};
+    assert_int_equal(pb_usb_source_create(&h.base, &l, &o, &src, &err), POSE_OK);
+    memset(&st, 0, sizeof st);
+    src->on_status = log_state;
+    src->on_status_user = &st;
+    int64_t t0 = pb_usb_now_ns();
+    for (int i = 0; i < 5; i++)
+        assert_int_equal(pb_source_read(src, &u, 1000), 1);
+    double took = (double)(pb_usb_now_ns() - t0) * 1e-9;
+    print_message("%sretried for %.3f s\n", st.log, took);
+    assert_int_equal(h.opens, 4); /* the first, the refused one on arrival, one refused retry, the one that works */
+    assert_true(took >= 0.038 && took < 0.5); /* two retries 20 ms apart */
+    assert_non_null(strstr(st.log, "disconnected: fake: found but not usable: Access denied\nwaiting: usb:1209:0002: reopened\n"));
     pb_source_destroy(src);
     /* not plugged in at open: DISCONNECTED at once, no error */
     fake g = {.base = {.ops = &fake_ops, .origin = "usb:1209:0002", .hotplug = 1}, .plugged = 0};

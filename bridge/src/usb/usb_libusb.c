@@ -247,12 +247,14 @@ static int live_read(pb_usb_transport *t, uint8_t *buf, size_t cap, int timeout_
         }
         if (l->active == 0 && !l->need_clear_halt)
             return PB_USB_READ_GONE; /* every transfer ended: no device */
+        /* handle events at least once, even when polled with timeout 0, then wait in slices of 100 ms */
         int64_t now = pb_usb_now_ns();
-        if (now >= deadline)
-            return 0;
         int64_t wait = deadline == INT64_MAX ? 100000000 : deadline - now;
+        wait = wait < 0 ? 0 : wait > 100000000 ? 100000000 : wait;
         struct timeval tv = {(time_t)(wait / 1000000000), (long)(wait % 1000000000 / 1000)};
         libusb_handle_events_timeout_completed(l->ctx, &tv, NULL);
+        if (l->tail == l->head && !l->left && !l->need_clear_halt && pb_usb_now_ns() >= deadline)
+            return 0;
     }
 }
 
@@ -260,15 +262,18 @@ static int live_wait_arrival(pb_usb_transport *t, int timeout_ms)
 {
     live *l = (live *)t;
     int64_t deadline = pb_usb_now_ns() + (int64_t)timeout_ms * 1000000;
-    while (!l->arrived) {
+    for (;;) {
         int64_t left = deadline - pb_usb_now_ns();
-        if (left <= 0)
-            return 0;
+        left = left < 0 ? 0 : left;
         struct timeval tv = {(time_t)(left / 1000000000), (long)(left % 1000000000 / 1000)};
-        libusb_handle_events_timeout_completed(l->ctx, &tv, NULL);
+        libusb_handle_events_timeout_completed(l->ctx, &tv, NULL); /* once at least, even for timeout 0 */
+        if (l->arrived) {
+            l->arrived = 0;
+            return 1;
+        }
+        if (pb_usb_now_ns() >= deadline)
+            return 0;
     }
-    l->arrived = 0;
-    return 1;
 }
 
 static void live_destroy(pb_usb_transport *t)

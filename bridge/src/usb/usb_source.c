@@ -19,6 +19,7 @@ typedef struct usb_source {
     int open;
     int64_t last_rx_ns, next_reopen_ns;
     uint64_t reopens;
+    int retry_open; /* hotplug reported the device, but opening it failed: retry every reopen_ms */
     int last_fault; /* what the FAULT state reports, to call back once per kind */
     long hold;
     uint32_t *out_channels;
@@ -192,16 +193,20 @@ static int usb_read(pb_source *src, pb_update *out, int timeout_ms)
     for (;;) {
         int64_t now = pb_usb_now_ns();
         if (!s->open) {
-            int arrived = 0;
+            /* With hotplug, wait for the arrival; an open that fails right after it (udev still setting
+             * permissions, the device still starting) is retried every reopen_ms until it works. */
+            int poll = !s->t->hotplug || s->retry_open, arrived = 0;
             if (s->t->hotplug && s->t->ops->wait_arrival) {
-                int64_t w = deadline == INT64_MAX ? 1000 : (deadline - now) / 1000000;
+                int64_t until = poll && s->next_reopen_ns < deadline ? s->next_reopen_ns : deadline;
+                int64_t w = until == INT64_MAX ? 1000 : (until - now) / 1000000;
                 arrived = s->t->ops->wait_arrival(s->t, (int)(w > 1000 ? 1000 : w < 0 ? 0 : w));
                 now = pb_usb_now_ns();
             }
-            if (arrived || (!s->t->hotplug && now >= s->next_reopen_ns)) {
+            if (arrived || (poll && now >= s->next_reopen_ns)) {
                 pb_error e;
                 if (s->t->ops->open(s->t, &e) == POSE_OK) {
                     s->open = 1;
+                    s->retry_open = 0;
                     s->reopens++;
                     s->last_rx_ns = now;
                     pb_source_set_state(&s->base, PB_SOURCE_WAITING, "%s: reopened%s", s->t->origin,
@@ -211,6 +216,8 @@ static int usb_read(pb_source *src, pb_update *out, int timeout_ms)
                 if (strcmp(s->base.message, e.message) != 0)
                     pb_source_set_state(&s->base, PB_SOURCE_DISCONNECTED, "%s", e.message);
                 s->next_reopen_ns = now + (int64_t)s->opt.reopen_ms * 1000000;
+                if (arrived)
+                    s->retry_open = 1;
             }
             if (now >= deadline)
                 return 0;
