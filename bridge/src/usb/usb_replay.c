@@ -10,6 +10,7 @@
 #include <time.h>
 
 #include "pb_warn.h"
+#include "timeline.h"
 #include "usb_source.h"
 #include "usbmon.h"
 
@@ -18,6 +19,7 @@ typedef struct replay {
     pb_usbmon_capture *cap;
     pb_usb_replay_options opt;
     uint32_t *events; /* C and E events of the endpoint, in file order */
+    int64_t *times;   /* their replay times (ns): the kernel's wrap undone, jumps taken out */
     size_t count, pos;
     int64_t t0_ns;    /* the first event's time: recorded times start at 0 */
     int64_t base_wall, base_t, loop_offset;
@@ -33,7 +35,7 @@ static const pb_usbmon_event *ev(const replay *r, size_t i)
 
 static int64_t ev_t(const replay *r, size_t i)
 {
-    return ev(r, i)->t_us * 1000 - r->t0_ns;
+    return r->times[i] - r->t0_ns;
 }
 
 static pose_status replay_open(pb_usb_transport *t, pb_error *err)
@@ -138,6 +140,7 @@ static void replay_destroy(pb_usb_transport *t)
     replay *r = (replay *)t;
     pb_usbmon_capture_free(r->cap);
     free(r->events);
+    free(r->times);
     free(r);
 }
 
@@ -163,7 +166,8 @@ pose_status pb_usb_replay_create(pb_usbmon_capture *cap, const char *origin, con
     if (!(r->opt.speed > 0))
         r->opt.speed = 1.0;
     r->events = malloc((cap->count ? cap->count : 1) * sizeof *r->events);
-    if (!r->events) {
+    r->times = malloc((cap->count ? cap->count : 1) * sizeof *r->times);
+    if (!r->events || !r->times) {
         replay_destroy(&r->base);
         return pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "%s: out of memory", origin);
     }
@@ -181,14 +185,28 @@ pose_status pb_usb_replay_create(pb_usbmon_capture *cap, const char *origin, con
         replay_destroy(&r->base);
         return st;
     }
-    r->t0_ns = ev(r, 0)->t_us * 1000;
-    for (size_t i = 1; i < r->count; i++)
-        if (ev(r, i)->t_us < ev(r, i - 1)->t_us) {
-            pose_status st = pb_fail(err, POSE_ERR_FORMAT, "%s:%u: time stamp %lld us is before the line before's",
-                                     r->base.origin, ev(r, i)->line, (long long)ev(r, i)->t_us);
-            replay_destroy(&r->base);
-            return st;
-        }
+    /* The kernel's text time stamps are (seconds mod 4096) * 10^6 + microseconds: a capture longer than
+     * 68 minutes wraps, which is undone; other jumps back, or ahead by more than a minute, are taken out
+     * (pb_timeline) with a warning naming the line. */
+    const int64_t wrap_us = INT64_C(4096000000);
+    int64_t unwrap = 0, prev_us = -1;
+    pb_timeline tl;
+    pb_timeline_init(&tl, PB_TIMELINE_MAX_GAP_NS);
+    for (size_t i = 0; i < r->count; i++) {
+        const pb_usbmon_event *e = ev(r, i);
+        if (prev_us >= 0 && e->t_us < prev_us && prev_us < wrap_us && prev_us - e->t_us > wrap_us / 2)
+            unwrap += wrap_us;
+        prev_us = e->t_us;
+        int64_t jump = 0;
+        r->times[i] = pb_timeline_map(&tl, (e->t_us + unwrap) * 1000, &jump);
+        if (jump < 0)
+            pb_warn("%s:%u: time stamp %lld us goes back %.6f s; replayed one step after the transfer before",
+                    r->base.origin, e->line, (long long)e->t_us, (double)-jump * 1e-9);
+        else if (jump > 0)
+            pb_warn("%s:%u: time stamp %lld us jumps %.1f s ahead; taken out (replayed one step later)",
+                    r->base.origin, e->line, (long long)e->t_us, (double)jump * 1e-9);
+    }
+    r->t0_ns = r->times[0];
     return pb_usb_source_create(&r->base, layout, &r->opt.source, out, err);
 }
 
