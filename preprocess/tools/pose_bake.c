@@ -4,6 +4,9 @@
  * Exit status: 0 success, 1 the bake failed (message on stderr), 2 usage.
  */
 #include "bake_pipeline.h"
+#ifdef POSE_HAVE_NIFTI
+#include "bake_labels.h"
+#endif
 #include "pose_cli.h"
 
 #include <dirent.h>
@@ -25,6 +28,8 @@ static void usage(FILE *f)
             "                 [--backend lattice|tetgen] [-K N] [--threads N] [--no-cor] [--cor-step S]\n"
             "                 [--no-fem] [--fem-poisson NU]\n"
             "                 [--vtu FILE] [--json] [--report FILE] [--quiet]\n"
+            "       pose-bake --labels SEG.nii.gz --label-names LABELS.json [--volume CT.nii.gz]\n"
+            "                 [--hu-threshold HU] --template TEMPLATE.json -o OUT.rig [options above]\n"
             "\n"
             "Builds a rig for the pose runtime: fits the template's joints to the bones,\n"
             "voxelizes and tetrahedralizes the body, computes harmonic skinning weights,\n"
@@ -46,6 +51,11 @@ static void usage(FILE *f)
             "                         the direct formula and slower: 1/256 ~ 4x)\n"
             "  --no-fem               no fem section (the rig then has no POSE_FEM)\n"
             "  --fem-poisson NU       soft tissue's Poisson ratio for POSE_FEM (default %.2f)\n"
+            "  --labels SEG.nii[.gz]  bake from a label image (NIfTI) instead of meshes: body =\n"
+            "                         labels + CT above --hu-threshold (default -500), largest\n"
+            "                         region, slices filled; bones = labels the template names\n"
+            "  --label-names FILE     JSON {\"id\": \"name\"} (names match the template's bones)\n"
+            "  --volume CT.nii[.gz]   the CT/MRI on the labels' grid (body threshold)\n"
             "  --vtu FILE             also write the tet mesh, labels and weights for ParaView\n"
             "  --json                 print the report as JSON on stdout\n"
             "  --report FILE          write the JSON report to FILE\n"
@@ -220,6 +230,8 @@ static void print_summary(const pp_bake_report *r, const pp_bake_options *o)
 int main(int argc, char **argv)
 {
     pp_bake_options o = {0};
+    const char *labels_path = NULL, *names_path = NULL, *volume_path = NULL;
+    double hu = 0;
     path_list bones = {0}, organs = {0};
     int json = 0, quiet = 0, status = 2;
     const char *report_path = NULL;
@@ -228,7 +240,7 @@ int main(int argc, char **argv)
     enum { OPT_BONES = POSE_CLI_LONG_ONLY, OPT_ORGANS, OPT_SKIN, OPT_TEMPLATE, OPT_VTU, OPT_REPORT,
            OPT_RESOLUTION, OPT_TARGET_VERTICES, OPT_BACKEND, OPT_THREADS, OPT_COR_STEP, OPT_NO_COR,
            OPT_NO_FEM, OPT_FEM_POISSON,
-           OPT_JSON, OPT_QUIET, OPT_VERSION };
+           OPT_JSON, OPT_QUIET, OPT_VERSION, OPT_LABELS, OPT_LABEL_NAMES, OPT_VOLUME, OPT_HU };
     static const struct option options[] = {
         {"skin", required_argument, NULL, OPT_SKIN},
         {"bones", required_argument, NULL, OPT_BONES},
@@ -245,6 +257,10 @@ int main(int argc, char **argv)
         {"no-fem", no_argument, NULL, OPT_NO_FEM},
         {"fem-poisson", required_argument, NULL, OPT_FEM_POISSON},
         {"vtu", required_argument, NULL, OPT_VTU},
+        {"labels", required_argument, NULL, OPT_LABELS},
+        {"label-names", required_argument, NULL, OPT_LABEL_NAMES},
+        {"volume", required_argument, NULL, OPT_VOLUME},
+        {"hu-threshold", required_argument, NULL, OPT_HU},
         {"json", no_argument, NULL, OPT_JSON},
         {"report", required_argument, NULL, OPT_REPORT},
         {"quiet", no_argument, NULL, OPT_QUIET},
@@ -340,6 +356,20 @@ int main(int argc, char **argv)
                 goto out;
             o.fem_poisson = d;
             break;
+        case OPT_LABELS:
+            labels_path = cli.value;
+            break;
+        case OPT_LABEL_NAMES:
+            names_path = cli.value;
+            break;
+        case OPT_VOLUME:
+            volume_path = cli.value;
+            break;
+        case OPT_HU:
+            if (pose_cli_double(&cli, -2000, 5000, &d) < 0)
+                goto out;
+            hu = d;
+            break;
         case OPT_JSON:
             json = 1;
             break;
@@ -350,7 +380,21 @@ int main(int argc, char **argv)
             goto out;
         }
     }
-    if (!o.skin_path || !bones.n || !o.template_path || !o.output_path) {
+    if (labels_path) {
+#ifdef POSE_HAVE_NIFTI
+        if (!names_path || !o.template_path || !o.output_path || o.skin_path || bones.n) {
+            fprintf(stderr, "pose-bake: --labels needs --label-names, --template and -o, and "
+                            "takes no --skin or --bones (see --help)\n");
+            goto out;
+        }
+#else
+        fprintf(stderr, "pose-bake: built without NIfTI support (libnifti2-dev): no --labels\n");
+        goto out;
+#endif
+    } else if (names_path || volume_path) {
+        fprintf(stderr, "pose-bake: --label-names and --volume go with --labels\n");
+        goto out;
+    } else if (!o.skin_path || !bones.n || !o.template_path || !o.output_path) {
         fprintf(stderr, "pose-bake: --skin, --bones, --template and -o are required (see --help)\n");
         goto out;
     }
@@ -370,7 +414,19 @@ int main(int argc, char **argv)
 
     pp_bake_report rep;
     char err[1024];
-    int rc = pp_bake(&o, &rep, err, sizeof err);
+    int rc = 0;
+#ifdef POSE_HAVE_NIFTI
+    pp_labels_report lrep;
+    memset(&lrep, 0, sizeof lrep);
+    if (labels_path) {
+        const pp_labels_options lo = {labels_path, names_path, volume_path, o.template_path, hu, 0};
+        rc = pp_labels_prepare(&lo, &o, &lrep, err, sizeof err);
+    }
+    if (rc < 0)
+        memset(&rep, 0, sizeof rep);
+    else
+#endif
+        rc = pp_bake(&o, &rep, err, sizeof err);
     if (ps.tty && rc < 0)
         fputc('\n', stderr);
     if (rc < 0) {
@@ -379,6 +435,19 @@ int main(int argc, char **argv)
     } else {
         status = 0;
         char *text = (json || report_path) ? pp_bake_report_json(&rep, &o) : NULL;
+#ifdef POSE_HAVE_NIFTI
+        if (text && labels_path) {
+            char *merged = pp_labels_report_json(text, &lrep, &rep);
+            free(text);
+            text = merged;
+        }
+        if (labels_path && !json)
+            for (size_t h = 0; h < lrep.head_count; h++)
+                printf("femoral head %s (%s): sphere r %.1f mm at RAS (%.1f %.1f %.1f) mm\n",
+                       lrep.heads[h].joint, lrep.heads[h].label, lrep.heads[h].radius_mm,
+                       lrep.heads[h].centre_ras_mm[0], lrep.heads[h].centre_ras_mm[1],
+                       lrep.heads[h].centre_ras_mm[2]);
+#endif
         if (json && text)
             printf("%s\n", text);
         else if (!json)
@@ -399,6 +468,9 @@ int main(int argc, char **argv)
         free(text);
     }
     pp_bake_report_free(&rep);
+#ifdef POSE_HAVE_NIFTI
+    pp_labels_cleanup(&lrep);
+#endif
 out:
     list_free(&bones);
     list_free(&organs);

@@ -3,8 +3,9 @@
  *
  * Per call: (1) every posed tet vertex into the output grid's index space
  * (parts over vertices); (2) per z-slab of the output (one slab per part):
- * fill with background, then for every tet in index order whose z range
- * meets the slab, scan its voxels row by row. In output index space the
+ * for every tet in index order whose z range meets the slab, scan its
+ * voxels row by row, marking them covered; (3) the voxels left uncovered
+ * get the background, or their neighbours' values in a mesh crack. In output index space the
  * barycentric coordinates are affine in i along a row, so each row's span
  * inside the tet is an interval found from the four coordinates (no
  * per-voxel inside test), and the preimage in the rest image's index space
@@ -205,7 +206,7 @@ size_t pose_volume_sample_bytes(const pose_volume_sampler *s, int intensity, int
     size_t per = (intensity ? sizeof(float) : 0) + (labels ? sizeof(uint16_t) : 0);
     /* outputs written; rest samples read about once each where the body is
      * (bounded by the output size); posed and index vertices, tets. */
-    return 2 * nv * per + 2 * nv + 3 * s->vertex_count * sizeof(float) * 3 +
+    return 2 * nv * per + 3 * nv + 3 * s->vertex_count * sizeof(float) * 3 +
            s->tet_count * 4 * sizeof(uint32_t);
 }
 
@@ -294,31 +295,55 @@ static inline void sample_rest_inside(const pose_volume_desc *rest, size_t sy, s
     dst_i[at] = c0 + fz * (c1 - c0);
 }
 
-/* Narrow [lo, hi] to the i where c + d * i >= -eps. */
-static inline void clip_span(double c, double d, double *lo, double *hi)
+static inline float minf4(float a, float b, float c, float d)
+{
+    float x = a < b ? a : b, y = c < d ? c : d;
+    return x < y ? x : y;
+}
+
+static inline float maxf4(float a, float b, float c, float d)
+{
+    float x = a > b ? a : b, y = c > d ? c : d;
+    return x > y ? x : y;
+}
+
+/* ceil / floor of a value well inside the int range. */
+static inline int iceil(double x)
+{
+    int i = (int)x;
+    return i + ((double)i < x);
+}
+
+static inline int ifloor(double x)
+{
+    int i = (int)x;
+    return i - ((double)i > x);
+}
+
+/* One barycentric coordinate along a row: b(i) = c + d i >= -eps narrows
+ * [lo, hi]; rd = 1 / d (0 when d is 0). */
+static inline void clip_span(double c, double d, double rd, double *lo, double *hi)
 {
     if (d > 1e-12) {
-        double v = (-VOL_EPS - c) / d;
+        double v = (-VOL_EPS - c) * rd;
         *lo = v > *lo ? v : *lo;
     } else if (d < -1e-12) {
-        double v = (-VOL_EPS - c) / d;
+        double v = (-VOL_EPS - c) * rd;
         *hi = v < *hi ? v : *hi;
-    }
-    else if (c < -VOL_EPS)
+    } else if (c < -VOL_EPS) {
         *hi = -1e30;
+    }
 }
 
 static void raster_tet(const pose_volume_sampler *s, size_t t, int z0, int z1)
 {
     const uint32_t *tv = s->tets + 4 * t;
     const float *q[4], *r[4];
-    for (int c = 0; c < 4; c++) {
+    for (int c = 0; c < 4; c++)
         q[c] = s->posed_index + 3 * (size_t)tv[c];
-        r[c] = s->rest_index + 3 * (size_t)tv[c];
-    }
-    float zmin = fminf(fminf(q[0][2], q[1][2]), fminf(q[2][2], q[3][2]));
-    float zmax = fmaxf(fmaxf(q[0][2], q[1][2]), fmaxf(q[2][2], q[3][2]));
-    int k0 = (int)ceilf(zmin - 1e-4f), k1 = (int)floorf(zmax + 1e-4f);
+    float zmin = minf4(q[0][2], q[1][2], q[2][2], q[3][2]);
+    float zmax = maxf4(q[0][2], q[1][2], q[2][2], q[3][2]);
+    int k0 = iceil(zmin - 1e-4f), k1 = ifloor(zmax + 1e-4f);
     if (k0 < z0)
         k0 = z0;
     if (k1 > z1 - 1)
@@ -326,22 +351,17 @@ static void raster_tet(const pose_volume_sampler *s, size_t t, int z0, int z1)
     if (k0 > k1)
         return;
     const int nx = (int)s->out.nx, ny = (int)s->out.ny;
-    float ymin = fminf(fminf(q[0][1], q[1][1]), fminf(q[2][1], q[3][1]));
-    float ymax = fmaxf(fmaxf(q[0][1], q[1][1]), fmaxf(q[2][1], q[3][1]));
-    float xmin = fminf(fminf(q[0][0], q[1][0]), fminf(q[2][0], q[3][0]));
-    float xmax = fmaxf(fmaxf(q[0][0], q[1][0]), fmaxf(q[2][0], q[3][0]));
-    int j0 = (int)ceilf(ymin - 1e-4f), j1 = (int)floorf(ymax + 1e-4f);
-    int i0 = (int)ceilf(xmin - 1e-4f), i1 = (int)floorf(xmax + 1e-4f);
-    if (j0 < 0)
-        j0 = 0;
-    if (j1 > ny - 1)
-        j1 = ny - 1;
+    float xmin = minf4(q[0][0], q[1][0], q[2][0], q[3][0]);
+    float xmax = maxf4(q[0][0], q[1][0], q[2][0], q[3][0]);
+    int i0 = iceil(xmin - 1e-4f), i1 = ifloor(xmax + 1e-4f);
     if (i0 < 0)
         i0 = 0;
     if (i1 > nx - 1)
         i1 = nx - 1;
-    if (j0 > j1 || i0 > i1)
+    if (i0 > i1)
         return;
+    for (int c = 0; c < 4; c++)
+        r[c] = s->rest_index + 3 * (size_t)tv[c];
     /* D = [q1-q0 q2-q0 q3-q0]; b = D^-1 (x - q0); rest = r0 + E b. */
     double D[3][3], E[3][3];
     for (int a = 0; a < 3; a++)
@@ -368,9 +388,10 @@ static void raster_tet(const pose_volume_sampler *s, size_t t, int z0, int z1)
                        D[0][2] * D[1][0] - D[0][0] * D[1][2]},
                       {D[1][0] * D[2][1] - D[1][1] * D[2][0], D[0][1] * D[2][0] - D[0][0] * D[2][1],
                        D[0][0] * D[1][1] - D[0][1] * D[1][0]}};
+    const double inv_det = 1.0 / det;
     for (int a = 0; a < 3; a++)
         for (int c = 0; c < 3; c++)
-            B[a][c] /= det;
+            B[a][c] *= inv_det;
     double M[3][3];
     for (int a = 0; a < 3; a++)
         for (int c = 0; c < 3; c++)
@@ -388,21 +409,51 @@ static void raster_tet(const pose_volume_sampler *s, size_t t, int z0, int z1)
     uint16_t *dst_l = s->dst_labels;
     /* Barycentric coordinates change along i by the first column of B. */
     const double d1 = B[0][0], d2 = B[1][0], d3 = B[2][0], d0 = -(d1 + d2 + d3);
+    const double rd1 = fabs(d1) > 1e-12 ? 1.0 / d1 : 0.0, rd2 = fabs(d2) > 1e-12 ? 1.0 / d2 : 0.0,
+                 rd3 = fabs(d3) > 1e-12 ? 1.0 / d3 : 0.0, rd0 = fabs(d0) > 1e-12 ? 1.0 / d0 : 0.0;
     const float mx = (float)M[0][0], my = (float)M[1][0], mz = (float)M[2][0];
-    for (int k = k0; k <= k1; k++)
+    /* The six edges, for each plane's y range. */
+    static const int edge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+    for (int k = k0; k <= k1; k++) {
+        /* y extent of the tet's section by the plane z = k. */
+        double ylo = 1e30, yhi = -1e30;
+        for (int e = 0; e < 6; e++) {
+            const float *a = q[edge[e][0]], *b = q[edge[e][1]];
+            double za = a[2] - (double)k, zb = b[2] - (double)k;
+            if ((za > 1e-4 && zb > 1e-4) || (za < -1e-4 && zb < -1e-4))
+                continue;
+            double y;
+            if (fabs(za - zb) < 1e-12) {
+                y = a[1] < b[1] ? a[1] : b[1];
+                ylo = y < ylo ? y : ylo;
+                y = a[1] > b[1] ? a[1] : b[1];
+                yhi = y > yhi ? y : yhi;
+                continue;
+            }
+            double u = za / (za - zb);
+            u = u < 0 ? 0 : u > 1 ? 1 : u;
+            y = a[1] + u * ((double)b[1] - a[1]);
+            ylo = y < ylo ? y : ylo;
+            yhi = y > yhi ? y : yhi;
+        }
+        int j0 = iceil(ylo - 1e-3), j1 = ifloor(yhi + 1e-3);
+        if (j0 < 0)
+            j0 = 0;
+        if (j1 > ny - 1)
+            j1 = ny - 1;
         for (int j = j0; j <= j1; j++) {
             double x0[3] = {-(double)q[0][0], j - (double)q[0][1], k - (double)q[0][2]};
             double b1 = B[0][0] * x0[0] + B[0][1] * x0[1] + B[0][2] * x0[2];
             double b2 = B[1][0] * x0[0] + B[1][1] * x0[1] + B[1][2] * x0[2];
             double b3 = B[2][0] * x0[0] + B[2][1] * x0[1] + B[2][2] * x0[2];
             double lo = i0, hi = i1;
-            clip_span(b1, d1, &lo, &hi);
-            clip_span(b2, d2, &lo, &hi);
-            clip_span(b3, d3, &lo, &hi);
-            clip_span(1.0 - b1 - b2 - b3, d0, &lo, &hi);
+            clip_span(b1, d1, rd1, &lo, &hi);
+            clip_span(b2, d2, rd2, &lo, &hi);
+            clip_span(b3, d3, rd3, &lo, &hi);
+            clip_span(1.0 - b1 - b2 - b3, d0, rd0, &lo, &hi);
             if (!(lo <= hi))
                 continue;
-            int ia = (int)ceil(lo), ib = (int)floor(hi);
+            int ia = iceil(lo), ib = ifloor(hi);
             if (ia > ib)
                 continue;
             /* The preimage at i = ia, then one add per voxel. */
@@ -425,9 +476,10 @@ static void raster_tet(const pose_volume_sampler *s, size_t t, int z0, int z1)
                                 row + (size_t)i);
                 }
         }
+    }
 }
 
-/* Pass 2: one z-slab per part. */
+/* Pass 2: one z-slab per part: every tet meeting the slab, in index order. */
 static void slab_task(void *ctx, unsigned part, unsigned parts)
 {
     pose_volume_sampler *s = ctx;
@@ -436,49 +488,48 @@ static void slab_task(void *ctx, unsigned part, unsigned parts)
     if (z0 >= z1)
         return;
     size_t plane = (size_t)s->out.nx * s->out.ny;
-    size_t b = (size_t)z0 * plane, e = (size_t)z1 * plane;
-    if (s->dst_intensity)
-        for (size_t v = b; v < e; v++)
-            s->dst_intensity[v] = s->rest.intensity_background;
-    if (s->dst_labels)
-        for (size_t v = b; v < e; v++)
-            s->dst_labels[v] = s->rest.label_background;
-    memset(s->covered + b, 0, e - b);
+    memset(s->covered + (size_t)z0 * plane, 0, (size_t)(z1 - z0) * plane);
     for (size_t t = 0; t < s->tet_count; t++)
         raster_tet(s, t, z0, z1);
 }
 
-/* Pass 3: a voxel no tet covers whose six neighbours all are covered sits
- * in a crack of the mesh (a centre on a sliver or a coarsening seam that
- * float rounding left out of every tet), not outside the body: it takes
- * its neighbours' mean intensity and its -x neighbour's label. Reads only
- * covered voxels, which this pass never writes: any thread count gives the
- * same bytes. */
-static void crack_task(void *ctx, unsigned part, unsigned parts)
+/* Pass 3, the voxels no tet covered. One whose six neighbours all are
+ * covered sits in a crack of the mesh (a centre on a sliver or a
+ * coarsening seam that float rounding left out of every tet), not outside
+ * the body: it takes its neighbours' mean intensity and its -x neighbour's
+ * label. The others are background. Reads only covered voxels, which this
+ * pass never writes: any thread count gives the same bytes. */
+static void fill_task(void *ctx, unsigned part, unsigned parts)
 {
     pose_volume_sampler *s = ctx;
     const size_t nx = s->out.nx, ny = s->out.ny, nz = s->out.nz, sy = nx, sz = nx * ny;
-    size_t z0 = pose__part_begin(nz, part, parts), z1 = pose__part_begin(nz, part + 1, parts);
-    if (z0 < 1)
-        z0 = 1;
-    if (z1 > nz - 1)
-        z1 = nz - 1;
+    const size_t z0 = pose__part_begin(nz, part, parts), z1 = pose__part_begin(nz, part + 1, parts);
     const uint8_t *c = s->covered;
+    float *di = s->dst_intensity;
+    uint16_t *dl = s->dst_labels;
+    const float bi = s->rest.intensity_background;
+    const uint16_t bl = s->rest.label_background;
     for (size_t k = z0; k < z1; k++)
-        for (size_t j = 1; j + 1 < ny; j++) {
-            size_t row = k * sz + j * sy;
-            for (size_t i = 1; i + 1 < nx; i++) {
+        for (size_t j = 0; j < ny; j++) {
+            const size_t row = k * sz + j * sy;
+            const int inner = k > 0 && k + 1 < nz && j > 0 && j + 1 < ny;
+            for (size_t i = 0; i < nx; i++) {
                 size_t v = row + i;
-                if (c[v] || !c[v - 1] || !c[v + 1] || !c[v - sy] || !c[v + sy] || !c[v - sz] ||
-                    !c[v + sz])
+                if (c[v])
                     continue;
-                if (s->dst_intensity) {
-                    const float *d = s->dst_intensity;
-                    s->dst_intensity[v] =
-                        (d[v - 1] + d[v + 1] + d[v - sy] + d[v + sy] + d[v - sz] + d[v + sz]) / 6.0f;
+                if (inner && i > 0 && i + 1 < nx && c[v - 1] && c[v + 1] && c[v - sy] &&
+                    c[v + sy] && c[v - sz] && c[v + sz]) {
+                    if (di)
+                        di[v] = (di[v - 1] + di[v + 1] + di[v - sy] + di[v + sy] + di[v - sz] +
+                                 di[v + sz]) / 6.0f;
+                    if (dl)
+                        dl[v] = dl[v - 1];
+                    continue;
                 }
-                if (s->dst_labels)
-                    s->dst_labels[v] = s->dst_labels[v - 1];
+                if (di)
+                    di[v] = bi;
+                if (dl)
+                    dl[v] = bl;
             }
         }
 }
@@ -509,7 +560,7 @@ pose_status pose_volume_sample(pose_volume_sampler *s, const pose_state *state,
     s->dst_labels = out_labels;
     pose__pool_run(s->pool, to_index_task, s);
     pose__pool_run(s->pool, slab_task, s);
-    pose__pool_run(s->pool, crack_task, s);
+    pose__pool_run(s->pool, fill_task, s);
     s->posed = NULL;
     s->dst_intensity = NULL;
     s->dst_labels = NULL;

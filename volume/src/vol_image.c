@@ -52,3 +52,12 @@ int pv_image_world_to_voxel(const pv_image *img, const double xyz[3], double ijk
         ijk[r] = (inv[r][0] * d[0] + inv[r][1] * d[1] + inv[r][2] * d[2]) / det;
     return 0;
 }
+
+void pv_image_model_affine(const pv_image *img, double out[3][4])
+{
+    for (int c = 0; c < 4; c++) {
+        out[0][c] = 1e-3 * img->affine[1][c];
+        out[1][c] = -1e-3 * img->affine[0][c];
+        out[2][c] = 1e-3 * img->affine[2][c];
+    }
+}

@@ -49,4 +49,13 @@ void pv_image_voxel_to_world(const pv_image *img, const double ijk[3], double xy
 /** The inverse (i, j, k) of a world point; returns -1 for a singular affine. */
 int pv_image_world_to_voxel(const pv_image *img, const double xyz[3], double ijk[3]);
 
+/**
+ * The rig model space of an image baked by pose-bake --labels: metres,
+ * facing +X (anterior), left +Y, up +Z (the templates' convention), from
+ * NIfTI's RAS+ millimetres: model = (y, -x, z) * 1e-3. out = that map
+ * composed with the image's voxel -> world affine (voxel index -> model),
+ * as pose_volume_grid and the bake use it.
+ */
+void pv_image_model_affine(const pv_image *img, double out[3][4]);
+
 #endif /* POSE_VOL_IMAGE_H */
