@@ -192,10 +192,17 @@ static void limb_directions(const char *clip_rel, const char *skel_rel, const ch
             worst = ang > worst ? ang : worst;
         }
     }
-    /* root motion: the clip's root displacement from its reference (the Hips
-     * OFFSET), in metres (x 0.056444), clip (x, y, z) -> rig (z, x, y) */
+    /* root motion: the clip's root displacement from its first frame (the maps'
+     * "root_origin": "first_frame"), in metres (x 0.056444), clip (x, y, z) ->
+     * rig (z, x, y): the rig starts where it rests, not a hip height above it */
     int hips = pb_clip_find_joint(clip, root);
-    const double *o = clip->joints[hips].offset;
+    double o[3];
+    memcpy(o, cp[hips], sizeof o); /* the last frame's, kept while frame 0 is computed */
+    double last[3] = {o[0], o[1], o[2]};
+    pb_clip_local(clip, pb_clip_frame(clip, 0), lq, lt);
+    pb_clip_world(clip, (const double (*)[4])lq, (const double (*)[3])lt, cq, cp);
+    memcpy(o, cp[hips], sizeof o);
+    memcpy(cp[hips], last, sizeof last);
     assert_near(pose.root_t[0], 0.056444 * (cp[hips][2] - o[2]), 1e-6);
     assert_near(pose.root_t[1], 0.056444 * (cp[hips][0] - o[0]), 1e-6);
     assert_near(pose.root_t[2], 0.056444 * (cp[hips][1] - o[1]), 1e-6);

@@ -27,6 +27,12 @@
  *       and the rig's frames; the clip's motion is rotated from one to the other.
  *   "scale": clip length unit -> rig unit (root motion), default 1.
  *   "root_motion": "none" | "horizontal" | "full" (default "none").
+ *   "root_origin": "reference" (default) | "first_frame": where root motion
+ *       is measured from. A zero reference pose puts a CMU clip's hips on
+ *       the floor (the height is in the channels), so the rig's pelvis
+ *       would rise by the performer's hip height; "first_frame" starts the
+ *       rig where it rests and moves it by the clip's displacement since its
+ *       first frame.
  *   "reference": "zero" (all channels 0, default) or a frame number: the clip
  *       pose taken to correspond to the rig's rest pose.
  *   "align": true (default): per joint, bend the rig's rest bone onto the
@@ -109,6 +115,7 @@ typedef struct pb_mapping {
     double up[3];              /**< the rig's up axis (for horizontal root motion) */
     double scale;
     pb_root_motion root_motion;
+    int root_from_first_frame; /**< "root_origin": "first_frame" */
     long reference_frame;      /**< -1: zero pose */
     int align;
     int has_filter;

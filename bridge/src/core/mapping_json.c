@@ -426,6 +426,15 @@ static pose_status parse_root(pb_mapping *m, const cJSON *root, pb_error *err)
             return pb_fail(err, POSE_ERR_FORMAT, "%s: root_motion: expected \"none\", \"horizontal\" or \"full\"",
                            m->path);
     }
+    v = cJSON_GetObjectItemCaseSensitive(root, "root_origin");
+    if (v) {
+        const char *s = cJSON_IsString(v) ? v->valuestring : "";
+        if (strcmp(s, "first_frame") == 0)
+            m->root_from_first_frame = 1;
+        else if (strcmp(s, "reference") != 0)
+            return pb_fail(err, POSE_ERR_FORMAT, "%s: root_origin: expected \"reference\" or \"first_frame\"",
+                           m->path);
+    }
     v = cJSON_GetObjectItemCaseSensitive(root, "reference");
     if (v) {
         double f;

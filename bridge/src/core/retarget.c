@@ -17,8 +17,8 @@
  * parents. The local target is R_j = Base_j^-1 W_j with
  * Base_j = W_parent * RestLocal_j, which is what pose_set_joint expects; a
  * rig hinge driven by a clip hinge takes only part of it (hinge_pose). Root
- * motion is the clip root's displacement from the reference, rotated by G
- * and scaled. */
+ * motion is the clip root's displacement from the reference (or from the
+ * clip's first frame: "root_origin"), rotated by G and scaled. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -53,6 +53,7 @@ struct pb_retarget {
     int *src;              /* per rig joint: clip joint or -1 */
     double (*ref_inv)[4];  /* per clip joint: Qs(ref)^-1 */
     double (*ref_p)[3];    /* per clip joint: reference world position */
+    double (*origin_p)[3]; /* per clip joint: where root motion is measured from (ref_p or frame 0) */
     double (*target)[4];   /* per rig joint: A_j Neutral_j */
     double G[4], Gi[4];
     double up[3], scale;
@@ -72,6 +73,7 @@ void pb_retarget_free(pb_retarget *r)
     free(r->src);
     free(r->ref_inv);
     free(r->ref_p);
+    free(r->origin_p);
     free(r->target);
     free(r->hinge);
     free(r->nw);
@@ -654,6 +656,7 @@ pose_status pb_retarget_create(const pb_mapping *map, const pb_clip *clip, const
     r->src = malloc(nr * sizeof *r->src);
     r->ref_inv = malloc(nc * sizeof *r->ref_inv);
     r->ref_p = malloc(nc * sizeof *r->ref_p);
+    r->origin_p = malloc(nc * sizeof *r->origin_p);
     r->target = malloc(nr * sizeof *r->target);
     r->wq = malloc(nc * sizeof *r->wq);
     r->wp = malloc(nc * sizeof *r->wp);
@@ -662,8 +665,8 @@ pose_status pb_retarget_create(const pb_mapping *map, const pb_clip *clip, const
     r->nw = malloc(nr * sizeof *r->nw);
     r->np = malloc(nr * sizeof *r->np);
     double *scratch = malloc(nc * 7 * sizeof *scratch);
-    if (!r->src || !r->ref_inv || !r->ref_p || !r->target || !r->wq || !r->wp || !r->rw || !r->hinge || !r->nw ||
-        !r->np || !scratch) {
+    if (!r->src || !r->ref_inv || !r->ref_p || !r->origin_p || !r->target || !r->wq || !r->wp || !r->rw ||
+        !r->hinge || !r->nw || !r->np || !scratch) {
         free(scratch);
         pb_retarget_free(r);
         return pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "out of memory");
@@ -678,7 +681,12 @@ pose_status pb_retarget_create(const pb_mapping *map, const pb_clip *clip, const
         return s;
     }
     const double *ref_values = map->reference_frame >= 0 ? pb_clip_frame(clip, (size_t)map->reference_frame) : NULL;
+    /* The root-motion origin first: the reference FK below must be the last to fill r->wq. */
+    if (map->root_from_first_frame && clip->frame_count > 0)
+        pb_clip_fk(clip, pb_clip_frame(clip, 0), scratch, r->wq, r->origin_p);
     pb_clip_fk(clip, ref_values, scratch, r->wq, r->ref_p);
+    if (!map->root_from_first_frame || clip->frame_count == 0)
+        memcpy(r->origin_p, r->ref_p, nc * sizeof *r->ref_p);
     for (int c = 0; c < clip->joint_count; c++)
         pb_quat_conj(r->wq[c], r->ref_inv[c]);
     pb_quat_copy(r->G, map->axes_q);
@@ -779,7 +787,7 @@ void pb_retarget_apply(pb_retarget *r, const double (*lq)[4], const double (*lt)
     if (r->root_motion != PB_ROOT_NONE && root_src >= 0) {
         double d[3];
         for (int a = 0; a < 3; a++)
-            d[a] = (r->wp[root_src][a] - r->ref_p[root_src][a]) * r->scale;
+            d[a] = (r->wp[root_src][a] - r->origin_p[root_src][a]) * r->scale;
         pb_quat_rotate(r->G, d, d);
         if (r->root_motion == PB_ROOT_HORIZONTAL) {
             double h = d[0] * r->up[0] + d[1] * r->up[1] + d[2] * r->up[2];
