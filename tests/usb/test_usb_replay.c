@@ -484,6 +484,54 @@ static void test_time_wrap_and_jumps(void **state)
     pb_source_destroy(src);
 }
 
+typedef struct unplug_watch {
+    int64_t gone_at, back_at;
+    char back_msg[256];
+} unplug_watch;
+
+static void on_unplug(pb_source *src, pb_source_state st, const char *msg, void *user)
+{
+    unplug_watch *w = user;
+    (void)src;
+    if (st == PB_SOURCE_DISCONNECTED && !w->gone_at)
+        w->gone_at = pb_usb_now_ns();
+    if (st == PB_SOURCE_WAITING && w->gone_at && !w->back_at) {
+        w->back_at = pb_usb_now_ns();
+        snprintf(w->back_msg, sizeof w->back_msg, "%s", msg);
+    }
+}
+
+/* At recorded timing the capture's unplug lasts as long as it did (200 ms): disconnected, then back on its
+ * (simulated) hotplug arrival with the next transfer. */
+static void test_unplug_at_recorded_timing(void **state)
+{
+    (void)state;
+    char p[1024];
+    pb_source *src;
+    pb_error err;
+    pb_usb_replay_options o = {.speed = 1.0};
+    assert_int_equal(pb_usb_replay_open(data_path(p, sizeof p, "usb/gonio_reach_faults.usbmon"), box(), &o, &src, &err),
+                     POSE_OK);
+    unplug_watch w = {0, 0, ""};
+    src->on_status = on_unplug;
+    src->on_status_user = &w;
+    assert_int_equal(pb_source_seek(src, 2950000000LL), 0);
+    pb_update u;
+    int64_t t = 0;
+    while (t < 3250000000LL) {
+        int r = pb_source_read(src, &u, 100);
+        assert_true(r >= 0);
+        if (r == 1)
+            t = u.t_ns;
+    }
+    double gone_s = (double)(w.back_at - w.gone_at) * 1e-9;
+    print_message("unplugged for %.3f s of wall time; back: %s\n", gone_s, w.back_msg);
+    assert_true(gone_s > 0.18 && gone_s < 0.3);
+    assert_non_null(strstr(w.back_msg, "reopened on hotplug arrival"));
+    assert_int_equal(src->state, PB_SOURCE_OK);
+    pb_source_destroy(src);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -494,6 +542,7 @@ int main(void)
         cmocka_unit_test(test_cut_capture),
         cmocka_unit_test(test_hotplug_reopen),
         cmocka_unit_test(test_time_wrap_and_jumps),
+        cmocka_unit_test(test_unplug_at_recorded_timing),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

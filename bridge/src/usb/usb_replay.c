@@ -24,6 +24,7 @@ typedef struct replay {
     int64_t t0_ns;    /* the first event's time: recorded times start at 0 */
     int64_t base_wall, base_t, loop_offset;
     int started;
+    int gone;         /* the capture's device left; it is back at its next transfer's time */
     int dev;          /* the address followed, -1 until the first event */
     int truncated_warned;
 } replay;
@@ -38,11 +39,45 @@ static int64_t ev_t(const replay *r, size_t i)
     return r->times[i] - r->t0_ns;
 }
 
+/* Wall time the event at pos is due (recorded timing). */
+static int64_t due_at(const replay *r, size_t pos)
+{
+    return r->base_wall + (int64_t)((double)(ev_t(r, pos) + r->loop_offset - r->base_t) / r->opt.speed);
+}
+
+/* The first completion at or after pos (the device's first transfer when it is back). */
+static size_t next_completion(const replay *r)
+{
+    size_t i = r->pos;
+    while (i < r->count && ev(r, i)->event != 'C')
+        i++;
+    return i;
+}
+
 static pose_status replay_open(pb_usb_transport *t, pb_error *err)
 {
-    (void)t;
-    (void)err;
-    return POSE_OK; /* the capture is the device: always there, the next event comes when it came */
+    replay *r = (replay *)t;
+    size_t back = next_completion(r);
+    /* Unplugged in the capture: absent until its next transfer (as fast as possible: at once). */
+    if (r->gone && !r->opt.as_fast_as_possible && back < r->count && pb_usb_now_ns() < due_at(r, back))
+        return pb_fail(err, POSE_ERR_NOT_FOUND, "%s: device not present (unplugged in the capture)", t->origin);
+    r->gone = 0;
+    return POSE_OK;
+}
+
+/* The simulated hotplug: the device arrives when the capture's next transfer is due. */
+static int replay_wait_arrival(pb_usb_transport *t, int timeout_ms)
+{
+    replay *r = (replay *)t;
+    size_t back = next_completion(r);
+    if (!r->gone || back >= r->count)
+        return 1;
+    int64_t until = pb_usb_now_ns() + (int64_t)timeout_ms * 1000000, due = due_at(r, back);
+    int64_t wake = due < until ? due : until;
+    struct timespec ts = {(time_t)(wake / 1000000000), (long)(wake % 1000000000)};
+    while (pb_usb_now_ns() < wake && clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) != 0) {
+    }
+    return pb_usb_now_ns() >= due;
 }
 
 static int replay_read(pb_usb_transport *t, uint8_t *buf, size_t cap, int timeout_ms, pb_usb_completion *c)
@@ -71,7 +106,7 @@ static int replay_read(pb_usb_transport *t, uint8_t *buf, size_t cap, int timeou
         }
         int64_t t_ns = ev_t(r, r->pos) + r->loop_offset;
         if (!r->opt.as_fast_as_possible) {
-            int64_t due = r->base_wall + (int64_t)((double)(t_ns - r->base_t) / r->opt.speed);
+            int64_t due = due_at(r, r->pos);
             if (due > deadline) {
                 struct timespec ts = {(time_t)(deadline / 1000000000), (long)(deadline % 1000000000)};
                 clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL);
@@ -87,12 +122,14 @@ static int replay_read(pb_usb_transport *t, uint8_t *buf, size_t cap, int timeou
             if (st != PB_USB_XFER_NO_DEVICE || r->dev < 0)
                 continue; /* refused for another reason, or the unplug a completion already reported */
             r->dev = -1;
+            r->gone = 1;
             return PB_USB_READ_GONE;
         }
         c->t_ns = t_ns;
         c->status = st;
         if (st == PB_USB_XFER_NO_DEVICE) {
             r->dev = -1; /* it re-enumerates, perhaps at another address */
+            r->gone = 1;
             c->len = 0;
             return 1;
         }
@@ -123,6 +160,7 @@ static int replay_seek(pb_usb_transport *t, int64_t t_ns)
             hi = mid;
     }
     r->pos = lo;
+    r->gone = 0;
     r->loop_offset = 0;
     r->started = 1;
     r->base_wall = pb_usb_now_ns();
@@ -145,7 +183,7 @@ static void replay_destroy(pb_usb_transport *t)
 }
 
 static const pb_usb_transport_ops replay_ops = {
-    "usbmon-replay", replay_open, replay_read, replay_seek, NULL, replay_close, replay_destroy,
+    "usbmon-replay", replay_open, replay_read, replay_seek, replay_wait_arrival, replay_close, replay_destroy,
 };
 
 pose_status pb_usb_replay_create(pb_usbmon_capture *cap, const char *origin, const pb_usb_layout *layout,
@@ -163,6 +201,7 @@ pose_status pb_usb_replay_create(pb_usbmon_capture *cap, const char *origin, con
     snprintf(r->base.origin, sizeof r->base.origin, "%s", origin ? origin : "usbmon capture");
     if (opt)
         r->opt = *opt;
+    r->base.hotplug = !r->opt.as_fast_as_possible; /* at recorded timing, the device comes back when it came back */
     if (!(r->opt.speed > 0))
         r->opt.speed = 1.0;
     r->events = malloc((cap->count ? cap->count : 1) * sizeof *r->events);
