@@ -183,6 +183,8 @@ static pose_status live_open(pb_usb_transport *t, pb_error *err)
         }
         l->want = ((ly->frame_bytes + (size_t)mps - 1) / (size_t)mps) * (size_t)mps;
         l->h = h;
+        t->bus = libusb_get_bus_number(list[i]);
+        t->dev = libusb_get_device_address(list[i]);
     }
     libusb_free_device_list(list, 1);
     if (!l->h) {

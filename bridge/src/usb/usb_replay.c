@@ -134,6 +134,8 @@ static int replay_read(pb_usb_transport *t, uint8_t *buf, size_t cap, int timeou
             return 1;
         }
         r->dev = e->dev;
+        t->bus = e->bus;
+        t->dev = e->dev;
         size_t n = e->captured < e->length ? e->captured : e->length;
         if (e->captured < e->length && !r->truncated_warned++)
             pb_warn("%s:%u: the capture holds %u of the transfer's %u bytes (the kernel's text capture keeps 32; "

@@ -57,6 +57,7 @@ struct pb_usb_transport {
     char origin[192];          /**< "usb:1209:0002" or the capture's file name */
     const pb_usb_layout *layout;/**< the source's, set before open */
     int hotplug;               /**< 1: arrivals are signalled (libusb hotplug), no polling */
+    uint16_t bus, dev;         /**< where the device is now (0 when unknown), for recordings */
 };
 
 typedef struct pb_usb_source_options {
