@@ -49,7 +49,8 @@ install(FILES "${PROJECT_SOURCE_DIR}/LICENSE" DESTINATION "${CMAKE_INSTALL_DATAD
 # list covers every file the install rules take from the build tree.
 add_custom_target(pose_install_ready)
 foreach(tgt IN ITEMS pose pose_static pose_synth pose_bridge pose_bridge_static
-                     pose-synth pose-bake pose-bridge pose-render pose-view pose-export)
+                     pose-synth pose-bake pose-bridge pose-render pose-view pose-export
+                     pose-volume)
   if(TARGET ${tgt})
     add_dependencies(pose_install_ready ${tgt})
   endif()

@@ -96,7 +96,7 @@ grep -q "^pose-render:" <<<"$available" ||
     die "pose-render is not configured (needs libosmesa6-dev and libpng-dev); see $log"
 cmake --build "$build" -j "$jobs" --target pose_install_ready >>"$log" 2>&1 || die "build failed; see $log"
 built=""
-for t in pose-synth pose-bake pose-bridge pose-render pose-export pose-view; do
+for t in pose-synth pose-bake pose-bridge pose-render pose-export pose-view pose-volume; do
     if grep -q "^$t:" <<<"$available"; then built+="$t "; fi
 done
 echo "built: ${built}and the libraries (cmake --install $build works now)"
@@ -231,6 +231,26 @@ else
     fi
 fi
 
+# A volumetric patient (issue 11): the bundled CT and its labels baked (coarse), both hips
+# flexed 45 degrees (sitting), the posed CT and labels written as NIfTI and slice PNGs.
+volume_tool=$(tool pose-volume)
+vol_dir="$out/volume"
+rm -rf "$vol_dir"
+if [ $have_bake -eq 1 ] && [ -n "$volume_tool" ] && [ -f "$root/data/volume/example_seg.nii.gz" ]; then
+    stage "+ volumetric patient: bake the bundled CT (data/volume), sit (hips flexed 45 deg)"
+    mkdir -p "$vol_dir"
+    if "$bake" --labels "$root/data/volume/example_seg.nii.gz" \
+        --label-names "$root/data/volume/labels.json" --volume "$root/data/volume/example_ct.nii.gz" \
+        --template "$root/preprocess/templates/lumbar_pelvis_hips.json" --target-vertices 15000 \
+        --no-cor --quiet --report "$vol_dir/bake.json" -o "$vol_dir/ct.rig" >>"$log" 2>&1; then
+        "$volume_tool" "$vol_dir/ct.rig" --ct "$root/data/volume/example_ct.nii.gz" \
+            --labels "$root/data/volume/example_seg.nii.gz" --pose hip_l=45,0,0 --pose hip_r=45,0,0 \
+            --nifti "$vol_dir/sitting" --png "$vol_dir/sitting" --json | tee -a "$log"
+    else
+        echo "demo: pose-bake --labels failed on the bundled CT; see $log"
+    fi
+fi
+
 now=$(date +%s)
 printf '   (%ds)\n' $((now - stage_t))
 echo
@@ -241,7 +261,7 @@ else
 fi
 find "$out" -maxdepth 1 -type f | sort | sed "s|^$out/|  |"
 echo "  frames/: $(find "$frames_dir" -name '*.png' | wc -l) PNG images"
-for d in "$hid_dir" "$can_dir" "$usb_dir"; do
+for d in "$hid_dir" "$can_dir" "$usb_dir" "$vol_dir"; do
     if [ -d "$d" ]; then echo "  $(basename "$d")/: $(find "$d" -name '*.png' | wc -l) PNG images"; fi
 done
 
