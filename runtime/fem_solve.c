@@ -6,6 +6,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "rt_vec.h"
+
 static size_t align64(size_t n)
 {
     return (n + 63u) & ~(size_t)63u;
@@ -227,15 +229,216 @@ typedef struct solve_ctx {
     float vol_product; /**< kappa_g (gvol . p) */
 } solve_ctx;
 
+static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const float *x, size_t t0);
+
 static void tets_rotate(solve_ctx *c, size_t b, size_t e)
 {
     const pose__fem_tet *tets = c->mesh->tets;
     pose__fem_work *w = c->w;
-    for (size_t t = b; t < e; t++) {
+    size_t t = b;
+    for (; t + 8 <= e; t += 8)
+        rotate_block(tets, w, c->x, t);
+    for (; t < e; t++) {
         float F[9], *rot = w->rot + 20 * t;
         tet_linearize(&tets[t], c->x, w->quat + 4 * t, rot, F);
         tet_corners(&tets[t], rot, rot + 9, rot[18], F, 1, w->corner + 12 * t);
     }
+}
+
+/* ---- 8 tets at once (lane l = tet t0 + l). The same operations as the
+ * scalar functions above, in the same order (no fused multiply-add: the
+ * build does not contract), so a tet gets the same bits in a block as
+ * alone, and the result does not depend on where parts split the tets.
+ * Per-tet data is gathered from the 64-byte records and the rotation
+ * records; the arithmetic runs 8 wide. */
+
+static const size_t k_lanes[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+
+static POSE__INLINE void load_block(const pose__fem_tet *tets, size_t t0, pose__v8f B[9], pose__v8f *vmu,
+                       pose__v8f *vkappa, uint32_t idx[4][8])
+{
+    const float *rec = (const float *)(const void *)(tets + t0);
+    const uint32_t *vi = (const uint32_t *)(const void *)(tets + t0);
+    for (int k = 0; k < 9; k++)
+        B[k] = V8_GATHER(rec, k_lanes, 16, 4 + k);
+    *vmu = V8_GATHER(rec, k_lanes, 16, 13);
+    *vkappa = V8_GATHER(rec, k_lanes, 16, 14);
+    for (int k = 0; k < 4; k++)
+        for (int l = 0; l < 8; l++)
+            idx[k][l] = vi[16 * l + k];
+}
+
+/* tet_corners, 8 wide; vol is kappa V (J - 1) (residual) or kappa V (C : G). */
+static POSE__INLINE void corners_block(const pose__v8f B[9], const pose__v8f R[9],
+                                       const pose__v8f C[9], const pose__v8f *vmu_p,
+                                       const pose__v8f *vol_p, const pose__v8f G[9],
+                                       int residual, float *out)
+{
+    const pose__v8f vmu = *vmu_p, vol = *vol_p;
+    pose__v8f H[9];
+    for (int r = 0; r < 3; r++)
+        for (int col = 0; col < 3; col++)
+            H[3 * r + col] = R[r] * G[col] + R[3 + r] * G[3 + col] + R[6 + r] * G[6 + col];
+    if (residual) {
+        H[0] -= V8_SPLAT(1.0f);
+        H[4] -= V8_SPLAT(1.0f);
+        H[8] -= V8_SPLAT(1.0f);
+    }
+    const pose__v8f third = V8_SPLAT(2.0f / 3.0f) * (H[0] + H[4] + H[8]);
+    pose__v8f S[9];
+    for (int r = 0; r < 3; r++)
+        for (int col = 0; col < 3; col++)
+            S[3 * r + col] =
+                vmu * (H[3 * r + col] + H[3 * col + r] - (r == col ? third : V8_SPLAT(0.0f)));
+    pose__v8f P[9];
+    for (int r = 0; r < 3; r++)
+        for (int col = 0; col < 3; col++)
+            P[3 * r + col] = R[3 * r] * S[col] + R[3 * r + 1] * S[3 + col] +
+                             R[3 * r + 2] * S[6 + col] + vol * C[3 * r + col];
+    const pose__v8f sign = V8_SPLAT(residual ? -1.0f : 1.0f);
+    pose__v8f f[4][3];
+    for (int a = 0; a < 3; a++)
+        f[0][a] = V8_SPLAT(0.0f);
+    for (int i = 0; i < 3; i++)
+        for (int r = 0; r < 3; r++) {
+            f[i + 1][r] = sign * (P[3 * r] * B[3 * i] + P[3 * r + 1] * B[3 * i + 1] +
+                                  P[3 * r + 2] * B[3 * i + 2]);
+            f[0][r] += f[i + 1][r];
+        }
+    for (int r = 0; r < 3; r++)
+        f[0][r] = -f[0][r];
+    for (int l = 0; l < 8; l++)
+        for (int k = 0; k < 4; k++)
+            for (int a = 0; a < 3; a++)
+                out[12 * l + 3 * k + a] = f[k][a][l];
+}
+
+static POSE__INLINE void gradient_block(const pose__v8f B[9], const pose__v8f d[4][3], pose__v8f G[9])
+{
+    for (int r = 0; r < 3; r++)
+        for (int col = 0; col < 3; col++)
+            G[3 * r + col] = (d[1][r] - d[0][r]) * B[col] + (d[2][r] - d[0][r]) * B[3 + col] +
+                             (d[3][r] - d[0][r]) * B[6 + col];
+}
+
+static POSE__INLINE void quat_to_mat_block(const pose__v8f q[4], pose__v8f R[9])
+{
+    const pose__v8f one = V8_SPLAT(1.0f), two = V8_SPLAT(2.0f);
+    const pose__v8f x = q[0], y = q[1], z = q[2], s = q[3];
+    R[0] = one - two * (y * y + z * z);
+    R[1] = two * (x * y - s * z);
+    R[2] = two * (x * z + s * y);
+    R[3] = two * (x * y + s * z);
+    R[4] = one - two * (x * x + z * z);
+    R[5] = two * (y * z - s * x);
+    R[6] = two * (x * z - s * y);
+    R[7] = two * (y * z + s * x);
+    R[8] = one - two * (x * x + y * y);
+}
+
+/* extract_rotation, 8 wide: a lane that has converged keeps its q (and
+ * the R made from it) while the others iterate. */
+static void rotation_block(const pose__v8f A[9], pose__v8f q[4], pose__v8f R[9])
+{
+    for (int it = 0; it < 24; it++) {
+        quat_to_mat_block(q, R);
+        pose__v8f om[3] = {V8_SPLAT(0.0f), V8_SPLAT(0.0f), V8_SPLAT(0.0f)}, d = V8_SPLAT(0.0f);
+        for (int c = 0; c < 3; c++) {
+            pose__v8f r0 = R[c], r1 = R[3 + c], r2 = R[6 + c];
+            pose__v8f a0 = A[c], a1 = A[3 + c], a2 = A[6 + c];
+            om[0] += r1 * a2 - r2 * a1;
+            om[1] += r2 * a0 - r0 * a2;
+            om[2] += r0 * a1 - r1 * a0;
+            d += r0 * a0 + r1 * a1 + r2 * a2;
+        }
+        pose__v8f absd = V8_NEG_WHERE(d, d);
+        pose__v8f s = V8_SPLAT(1.0f) / (absd + V8_SPLAT(1e-9f));
+        om[0] *= s;
+        om[1] *= s;
+        om[2] *= s;
+        pose__v8f w2 = om[0] * om[0] + om[1] * om[1] + om[2] * om[2];
+        pose__v8i go = (pose__v8i)(w2 >= V8_SPLAT(1e-12f));
+        if (!V8_ANY(go))
+            return;
+        pose__v8f a[3] = {V8_SPLAT(0.5f) * om[0], V8_SPLAT(0.5f) * om[1], V8_SPLAT(0.5f) * om[2]};
+        pose__v8f n[4] = {
+            q[0] + a[0] * q[3] + a[1] * q[2] - a[2] * q[1],
+            q[1] - a[0] * q[2] + a[1] * q[3] + a[2] * q[0],
+            q[2] + a[0] * q[1] - a[1] * q[0] + a[2] * q[3],
+            q[3] - a[0] * q[0] - a[1] * q[1] - a[2] * q[2],
+        };
+        pose__v8f len = V8_SPLAT(1.0f) / V8_SQRT(n[0] * n[0] + n[1] * n[1] + n[2] * n[2] + n[3] * n[3]);
+        for (int k = 0; k < 4; k++) {
+            pose__v8f u = n[k] * len;
+            q[k] = (pose__v8f)(((pose__v8i)u & go) | ((pose__v8i)q[k] & ~go));
+        }
+    }
+    quat_to_mat_block(q, R);
+}
+
+static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const float *x, size_t t0)
+{
+    pose__v8f B[9], vmu, vkappa;
+    uint32_t idx[4][8];
+    load_block(tets, t0, B, &vmu, &vkappa, idx);
+    pose__v8f d[4][3];
+    for (int k = 0; k < 4; k++)
+        for (int a = 0; a < 3; a++)
+            d[k][a] = V8_GATHER(x, idx[k], 3, a);
+    pose__v8f F[9], q[4], R[9], C[9];
+    gradient_block(B, d, F);
+    float *qs = w->quat + 4 * t0;
+    for (int k = 0; k < 4; k++)
+        q[k] = V8_GATHER(qs, k_lanes, 4, k);
+    rotation_block(F, q, R);
+    /* cofactor, as the scalar one */
+    C[0] = F[4] * F[8] - F[5] * F[7];
+    C[1] = F[5] * F[6] - F[3] * F[8];
+    C[2] = F[3] * F[7] - F[4] * F[6];
+    C[3] = F[2] * F[7] - F[1] * F[8];
+    C[4] = F[0] * F[8] - F[2] * F[6];
+    C[5] = F[1] * F[6] - F[0] * F[7];
+    C[6] = F[1] * F[5] - F[2] * F[4];
+    C[7] = F[2] * F[3] - F[0] * F[5];
+    C[8] = F[0] * F[4] - F[1] * F[3];
+    pose__v8f jm1 = (F[0] * C[0] + F[1] * C[1] + F[2] * C[2]) - V8_SPLAT(1.0f);
+    float *rot = w->rot + 20 * t0;
+    for (int l = 0; l < 8; l++) {
+        for (int k = 0; k < 4; k++)
+            qs[4 * l + k] = q[k][l];
+        for (int k = 0; k < 9; k++) {
+            rot[20 * l + k] = R[k][l];
+            rot[20 * l + 9 + k] = C[k][l];
+        }
+        rot[20 * l + 18] = jm1[l];
+    }
+    const pose__v8f vol = vkappa * jm1;
+    corners_block(B, R, C, &vmu, &vol, F, 1, w->corner + 12 * t0);
+}
+
+/* The product K p: the search direction p' = z + beta p formed per corner. */
+static void product_block(const pose__fem_tet *tets, pose__fem_work *w, float beta, size_t t0)
+{
+    pose__v8f B[9], vmu, vkappa;
+    uint32_t idx[4][8];
+    load_block(tets, t0, B, &vmu, &vkappa, idx);
+    const pose__v8f vb = V8_SPLAT(beta);
+    pose__v8f d[4][3];
+    for (int k = 0; k < 4; k++)
+        for (int a = 0; a < 3; a++)
+            d[k][a] = V8_GATHER(w->z, idx[k], 3, a) + vb * V8_GATHER(w->p, idx[k], 3, a);
+    pose__v8f G[9], R[9], C[9];
+    gradient_block(B, d, G);
+    const float *rot = w->rot + 20 * t0;
+    for (int k = 0; k < 9; k++) {
+        R[k] = V8_GATHER(rot, k_lanes, 20, k);
+        C[k] = V8_GATHER(rot, k_lanes, 20, 9 + k);
+    }
+    pose__v8f cg = V8_SPLAT(0.0f);
+    for (int k = 0; k < 9; k++)
+        cg += C[k] * G[k];
+    const pose__v8f vol = vkappa * cg;
+    corners_block(B, R, C, &vmu, &vol, G, 0, w->corner + 12 * t0);
 }
 
 /* The next search direction p' = z + beta p is formed per corner here and
@@ -245,7 +448,10 @@ static void tets_product(solve_ctx *c, size_t b, size_t e)
     const pose__fem_tet *tets = c->mesh->tets;
     pose__fem_work *w = c->w;
     const float beta = c->beta;
-    for (size_t t = b; t < e; t++) {
+    size_t t = b;
+    for (; t + 8 <= e; t += 8)
+        product_block(tets, w, beta, t);
+    for (; t < e; t++) {
         const pose__fem_tet *tt = &tets[t];
         float d[4][3];
         for (int k = 0; k < 4; k++) {
@@ -335,8 +541,12 @@ static void pass_task(void *ctx, unsigned part, unsigned parts)
     solve_ctx *c = ctx;
     const pose__fem_mesh *m = c->mesh;
     if (c->pass == PASS_ROTATE || c->pass == PASS_PRODUCT) {
-        size_t b = pose__part_begin(m->tet_count, part, parts);
-        size_t e = pose__part_begin(m->tet_count, part + 1, parts);
+        /* whole blocks of 8 tets per part (the product runs 8 wide) */
+        const size_t blocks = (m->tet_count + 7) / 8;
+        size_t b = 8 * pose__part_begin(blocks, part, parts);
+        size_t e = 8 * pose__part_begin(blocks, part + 1, parts);
+        if (e > m->tet_count)
+            e = m->tet_count;
         if (c->pass == PASS_ROTATE)
             tets_rotate(c, b, e);
         else

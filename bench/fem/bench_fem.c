@@ -9,6 +9,9 @@
  * tet's rotation found from identity), and warm, as a frame of an
  * animation: the state was posed at 90 % of the angles just before (the
  * mean of --reps such frames). Every run refines from the skinned pose.
+ * "cpu ms" is the process CPU time of a warm FEM frame (all threads, the
+ * pool's spinning included): on a machine shared with other work, where
+ * wall times stretch, cpu / threads bounds what two idle cores take.
  *
  *   fem RIG [--threads N] [--reps N] [--tolerance T] [--outer N]
  */
@@ -98,9 +101,9 @@ int main(int argc, char **argv)
         soft += tet.labels[t] == 0;
     printf("rig %s: %zu tet vertices, %zu tets (%zu soft), skin %.3f L; %d threads, %d reps\n",
            argv[1], tet.vertex_count, tet.tet_count, soft, v0 * 1e3, threads, reps);
-    printf("%-22s %8s %6s %8s %7s %7s %6s %5s %6s %6s %6s %6s %6s %6s\n", "posture",
+    printf("%-22s %8s %6s %8s %7s %7s %6s %5s %6s %6s %6s %6s %6s %6s %6s\n", "posture",
            skinning == POSE_COR ? "CoR dV%" : "DQS dV%", "ms", "FEM dV%", "cold ms", "warm ms",
-           "outer", "CG", "skin", "rot", "cg", "xfer", "ms/CG", "ratio");
+           "outer", "CG", "skin", "rot", "cg", "xfer", "ms/CG", "ratio", "cpu ms");
     pose_state_options so = {.size = sizeof so, .threads = threads};
     double worst = 0.0, slowest = 0.0;
     for (size_t p = 0; p < sizeof k_postures / sizeof k_postures[0]; p++) {
@@ -113,7 +116,7 @@ int main(int argc, char **argv)
         pose_set_method(fem, POSE_FEM);
         pose_fem_options fo = {.size = sizeof fo, .outer_iterations = outer, .tolerance = tol};
         pose_set_fem_options(fem, &fo);
-        double t_sk = 0.0, t_fem = 0.0, cold = 0.0;
+        double t_sk = 0.0, t_fem = 0.0, cold = 0.0, cpu = 0.0;
         pose_fem_stats sum = {0}, fs = {.size = sizeof fs};
         if (set_posture(rig, fem, &k_postures[p], 1.0f))
             return 1;
@@ -128,9 +131,10 @@ int main(int argc, char **argv)
                 return 1;
             double t0 = bench_now();
             pose_apply(sk);
-            double t1 = bench_now();
+            double t1 = bench_now(), c1 = bench_cpu_seconds();
             pose_apply(fem);
             double t2 = bench_now();
+            cpu += bench_cpu_seconds() - c1;
             t_sk += t1 - t0;
             t_fem += t2 - t1;
             pose_get_fem_stats(fem, &fs);
@@ -143,12 +147,12 @@ int main(int argc, char **argv)
         double vs = fx_mesh_volume(pose_tissue_positions(sk, skin, NULL), si.triangles, si.triangle_count);
         double vf = fx_mesh_volume(pose_tissue_positions(fem, skin, NULL), si.triangles, si.triangle_count);
         double ms = 1e3 / reps;
-        printf("%-22s %+8.3f %6.2f %+8.3f %7.1f %7.1f %6d %5d %6.2f %6.1f %6.1f %6.2f %6.3f %6.1f\n",
+        printf("%-22s %+8.3f %6.2f %+8.3f %7.1f %7.1f %6d %5d %6.2f %6.1f %6.1f %6.2f %6.3f %6.1f %6.1f\n",
                k_postures[p].name, 100 * (vs - v0) / v0, t_sk * ms, 100 * (vf - v0) / v0,
                cold * 1e3, t_fem * ms, fs.outer_iterations, fs.cg_iterations, sum.seconds_skin * ms,
                sum.seconds_rotations * ms, sum.seconds_cg * ms, sum.seconds_transfer * ms,
                sum.cg_iterations ? 1e3 * sum.seconds_cg / sum.cg_iterations : 0.0,
-               t_fem / t_sk);
+               t_fem / t_sk, cpu * ms);
         worst = fmax(worst, fabs(vf - v0) / v0);
         slowest = fmax(slowest, t_fem * ms);
         pose_state_free(sk);
