@@ -28,10 +28,12 @@ static int read_head(const char *path, unsigned char *buf, size_t cap, size_t *g
         return fail(err, n, "%s: cannot open: %s", path, strerror(errno ? errno : ENOENT));
     int k = gzread(g, buf, (unsigned)cap);
     int e = 0;
-    const char *msg = k < 0 ? gzerror(g, &e) : NULL;
+    char msg[128] = "read error";
+    if (k < 0) /* copied: zlib frees its message with the stream */
+        snprintf(msg, sizeof msg, "%s", gzerror(g, &e));
     gzclose(g);
     if (k < 0)
-        return fail(err, n, "%s: cannot read the header: %s", path, msg ? msg : "read error");
+        return fail(err, n, "%s: cannot read the header: %s", path, msg);
     *got = (size_t)k;
     return 0;
 }
