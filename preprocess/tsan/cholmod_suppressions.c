@@ -1,0 +1,17 @@
+/* SPDX-License-Identifier: Apache-2.0
+ * Compiled into every program that links pose_preprocess in a ThreadSanitizer
+ * build (-DPOSE_TSAN=ON): pose-bake, the tests and fixtures that bake.
+ * CHOLMOD's supernodal factorisation runs OpenMP threads (libgomp, not
+ * instrumented): TSan sees a worker's memset of CHOLMOD's workspace but not
+ * the OpenMP barrier that orders it before the main thread's next use, in
+ * these two CHOLMOD functions (the worker's frames are libgomp's, without
+ * symbols). Every other frame, pose-bake's own threads included, stays
+ * checked. Built in rather than a suppressions file so that no test has to
+ * carry TSAN_OPTIONS for the pose-bake it runs. */
+const char *__tsan_default_suppressions(void);
+
+const char *__tsan_default_suppressions(void)
+{
+    return "race:cholmod_clear_flag\n"
+           "race:cholmod_super_numeric\n";
+}
