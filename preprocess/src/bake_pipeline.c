@@ -303,7 +303,7 @@ static int write_rig(const pp_bake_options *o, bake_state *s, pp_bake_report *re
                           s->tet.labels,      s->w.influences, s->w.joints,
                           s->w.weights,       s->cor,        rep->tissue_count,
                           s->tissues,         meta,          s->clinical,
-                          o->no_fem ? NULL : &fem};
+                          o->no_fem ? NULL : &fem, o->volume_count, o->volumes};
     /* Write beside the target, then rename: a reader never sees half a rig. */
     size_t len = strlen(o->output_path) + 32;
     char *tmp = malloc(len);

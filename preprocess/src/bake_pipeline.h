@@ -63,6 +63,9 @@ typedef struct pp_bake_options {
     double cor_step;                /**< CoR weight-bin step (pp_cor_options.tolerance) */
     int no_fem;                     /**< write no fem section (rig without POSE_FEM) */
     double fem_poisson;             /**< soft tissue's Poisson ratio; 0: PP_BAKE_FEM_POISSON */
+    /** Rest images stored in the rig's volumes section (pose-bake --labels), or 0 / NULL. */
+    size_t volume_count;
+    const struct pose_rig_volume *volumes;
     /** Called at each stage's start (fraction_done of the whole bake) and end. */
     void (*progress)(pp_bake_stage stage, int finished, double fraction_done, void *user);
     void *user;

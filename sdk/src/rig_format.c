@@ -24,7 +24,7 @@ const char *pose__section_name(uint32_t type)
 bool pose__section_known(uint32_t type)
 {
     return (type >= POSE__SEC_SKELETON && type <= POSE__SEC_METADATA) || type == POSE__SEC_CLINICAL ||
-           type == POSE__SEC_FEM;
+           type == POSE__SEC_FEM || type == POSE__SEC_VOLUMES;
 }
 
 pose__skeleton_layout pose__skeleton_layout_of(uint64_t joints)

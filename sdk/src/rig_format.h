@@ -56,7 +56,7 @@ typedef enum pose__section_type {
     POSE__SEC_COR = 4,
     POSE__SEC_TISSUES = 5,
     POSE__SEC_METADATA = 6,
-    POSE__SEC_VOLUMES = 7, /* reserved for volumetric models */
+    POSE__SEC_VOLUMES = 7, /* rest images on voxel grids (pose/volume.h) */
     POSE__SEC_CLINICAL = 8, /* neutral posture, clinical axes and ranges per joint */
     POSE__SEC_FEM = 9       /* soft tissue material for POSE_FEM */
 } pose__section_type;
@@ -93,6 +93,11 @@ uint64_t pose__clinical_size_of(uint64_t joints);
 /** The fem section: header, then one 64-byte material record (soft tissue). */
 #define POSE__RIG_FEM_RECORD 64u
 #define POSE__RIG_FEM_SIZE (POSE__RIG_SECTION_HEADER + POSE__RIG_FEM_RECORD)
+/** The volumes section: header (count), 128-byte records, then each
+ *  volume's arrays (rig_volumes.c). */
+#define POSE__RIG_VOLUME_RECORD 128u
+#define POSE__RIG_MAX_VOLUMES 16u
+#define POSE__RIG_MAX_VOLUME_VOXELS ((uint64_t)1 << 31)
 /** Bytes one tissue's arrays take (positions, triangles, tet, bary, each padded). */
 uint64_t pose__tissue_data_size(uint64_t vertices, uint64_t triangles);
 

@@ -89,6 +89,8 @@ struct pose_rig {
     const pose__joint_limit *joint_limits;
     const pose__clinical_record *clinical; /* joint_count records, or NULL (no section) */
     const pose__fem_record *fem;           /* soft tissue material, or NULL (no POSE_FEM) */
+    const uint8_t *volumes;                /* the volumes section (checked), or NULL */
+    uint32_t volume_count;
 
     /* ---- tet mesh */
     size_t tet_vertex_count;

@@ -61,4 +61,15 @@ pose_status pose__clinical_validate(const pose_rig *rig, const pose__source *src
 /** The fem section's material record (when present): finite, in range. */
 pose_status pose__fem_validate(const pose_rig *rig, const pose__source *src);
 
+/** Map and check the volumes section (bytes p .. p + size of src) into
+ *  rig->volumes (rig_volumes.c). */
+pose_status pose__map_volumes(const pose__source *src, const uint8_t *p, uint64_t size,
+                              pose_rig *rig);
+/** Bytes of a volumes section for a description (0 when it has none). */
+uint64_t pose__volumes_size_of(const pose_rig_desc *d);
+/** Write the volumes section of d at s (pose__volumes_size_of(d) zeroed bytes). */
+void pose__volumes_write(uint8_t *s, const pose_rig_desc *d);
+/** A description's volumes: names, grids, arrays, sizes (before writing). */
+pose_status pose__volumes_check_desc(const pose_rig_desc *d);
+
 #endif /* POSE_RIG_IO_H */

@@ -466,6 +466,9 @@ static pose_status map_sections(const pose__source *src, const entry *e, uint32_
         st = map_clinical(src, find(e, n, POSE__SEC_CLINICAL), rig);
     if (st == POSE_OK && find(e, n, POSE__SEC_FEM))
         st = map_fem(src, find(e, n, POSE__SEC_FEM), rig);
+    if (st == POSE_OK && find(e, n, POSE__SEC_VOLUMES))
+        st = pose__map_volumes(src, src->base + find(e, n, POSE__SEC_VOLUMES)->offset,
+                               find(e, n, POSE__SEC_VOLUMES)->size, rig);
     if (st != POSE_OK)
         return st;
 

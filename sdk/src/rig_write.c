@@ -103,7 +103,8 @@ static pose_status check_desc(const pose_rig_desc *d)
                               "rig description: tissue '%s': missing positions, tet, bary or "
                               "triangles array", td->name);
     }
-    return check_clinical(d);
+    pose_status st = check_clinical(d);
+    return st == POSE_OK ? pose__volumes_check_desc(d) : st;
 }
 
 typedef struct section_plan {
@@ -237,7 +238,7 @@ pose_status pose__rig_serialize(const pose_rig_desc *d, const pose_allocator *al
         return st;
     size_t meta_len = d->metadata ? strlen(d->metadata) : 0;
 
-    section_plan plan[8];
+    section_plan plan[10];
     uint32_t n = 0;
     plan[n++] = (section_plan){POSE__SEC_SKELETON, 0, pose__skeleton_layout_of(d->joint_count).size};
     plan[n++] = (section_plan){POSE__SEC_TETMESH, 0,
@@ -253,6 +254,8 @@ pose_status pose__rig_serialize(const pose_rig_desc *d, const pose_allocator *al
         plan[n++] = (section_plan){POSE__SEC_CLINICAL, 0, pose__clinical_size_of(d->joint_count)};
     if (d->fem)
         plan[n++] = (section_plan){POSE__SEC_FEM, 0, POSE__RIG_FEM_SIZE};
+    if (d->volume_count)
+        plan[n++] = (section_plan){POSE__SEC_VOLUMES, 0, pose__volumes_size_of(d)};
 
     uint64_t total = POSE__RIG_HEADER_SIZE + pose__align64((uint64_t)n * POSE__RIG_ENTRY_SIZE);
     for (uint32_t i = 0; i < n; i++) {
@@ -277,6 +280,7 @@ pose_status pose__rig_serialize(const pose_rig_desc *d, const pose_allocator *al
         case POSE__SEC_TISSUES: write_tissues(s, d); break;
         case POSE__SEC_CLINICAL: write_clinical(s, d); break;
         case POSE__SEC_FEM: write_fem(s, d); break;
+        case POSE__SEC_VOLUMES: pose__volumes_write(s, d); break;
         case POSE__SEC_METADATA:
             put_u64(s, meta_len);
             memcpy(s + POSE__RIG_SECTION_HEADER, d->metadata, meta_len);
@@ -285,7 +289,8 @@ pose_status pose__rig_serialize(const pose_rig_desc *d, const pose_allocator *al
         uint8_t *e = img + POSE__RIG_HEADER_SIZE + i * POSE__RIG_ENTRY_SIZE;
         put_u32(e + POSE__ENT_TYPE, plan[i].type);
         /* Readers before pose 0.2 skip what they do not know only when it is optional. */
-        if (plan[i].type == POSE__SEC_CLINICAL || plan[i].type == POSE__SEC_FEM)
+        if (plan[i].type == POSE__SEC_CLINICAL || plan[i].type == POSE__SEC_FEM ||
+            plan[i].type == POSE__SEC_VOLUMES)
             put_u32(e + POSE__ENT_FLAGS, POSE__SECTION_OPTIONAL);
         put_u64(e + POSE__ENT_OFFSET, plan[i].offset);
         put_u64(e + POSE__ENT_SIZE, plan[i].size);

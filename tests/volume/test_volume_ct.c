@@ -111,6 +111,25 @@ static void test_hip_centres_on_the_femoral_heads(void **state)
     cJSON_Delete(root);
 }
 
+/* The bake stored the scan in the rig (the volumes section): the same
+ * labels and HU, on the scan's grid in model space. */
+static void test_rig_holds_the_scan(void **state)
+{
+    ct_fixture *f = *state;
+    assert_int_equal(pose_rig_volume_count(f->rig), 1);
+    pose_rig_volume v;
+    assert_int_equal(pose_rig_get_volume(f->rig, 0, &v), POSE_OK);
+    assert_string_equal(v.name, "scan");
+    assert_int_equal(v.grid.nx, f->rest.grid.nx);
+    assert_int_equal(v.grid.ny, f->rest.grid.ny);
+    assert_int_equal(v.grid.nz, f->rest.grid.nz);
+    assert_memory_equal(v.grid.affine, f->rest.grid.affine, sizeof v.grid.affine);
+    assert_non_null(v.intensity);
+    assert_non_null(v.labels);
+    assert_memory_equal(v.labels, f->labels, f->n * sizeof *f->labels);
+    assert_memory_equal(v.intensity, f->ct.data, f->n * sizeof *f->ct.data);
+}
+
 static pose_state *posed(const ct_fixture *f, float hip_l_flexion)
 {
     pose_state *st;
@@ -348,6 +367,7 @@ int main(int argc, char **argv)
     g_report = argv[2];
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hip_centres_on_the_femoral_heads),
+        cmocka_unit_test(test_rig_holds_the_scan),
         cmocka_unit_test(test_rest_comes_back),
         cmocka_unit_test(test_flex_hip_l_45),
     };

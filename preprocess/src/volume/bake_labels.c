@@ -16,6 +16,8 @@
 #include "labels_body.h"
 #include "vol_nifti.h"
 
+#include <pose/volume.h>
+
 #define MAX_LABEL 65535
 
 static char *read_text(const char *path, char *err, size_t n)
@@ -387,6 +389,28 @@ int pp_labels_prepare(const pp_labels_options *o, pp_bake_options *bake, pp_labe
     }
     pp_template_free(&t);
     if (rc == 0) {
+        /* The scan as the rig's rest image. */
+        r->volume = calloc(1, sizeof *r->volume);
+        r->volume_labels = malloc(nv * sizeof *r->volume_labels);
+        if (ct.data)
+            r->volume_intensity = malloc(nv * sizeof *r->volume_intensity);
+        if (!r->volume || !r->volume_labels || (ct.data && !r->volume_intensity)) {
+            rc = pp_fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+            goto done;
+        }
+        memcpy(r->volume_labels, lab, nv * sizeof *lab);
+        if (ct.data)
+            memcpy(r->volume_intensity, ct.data, nv * sizeof *ct.data);
+        r->volume->name = "scan";
+        r->volume->grid.nx = (uint32_t)nx, r->volume->grid.ny = (uint32_t)ny;
+        r->volume->grid.nz = (uint32_t)nz;
+        for (int a = 0; a < 3; a++)
+            for (int c = 0; c < 4; c++)
+                r->volume->grid.affine[a][c] = (float)model[a][c];
+        r->volume->intensity = r->volume_intensity;
+        r->volume->labels = r->volume_labels;
+        bake->volume_count = 1;
+        bake->volumes = r->volume;
         bake->skin_path = r->skin_path;
         bake->template_path = r->template_path;
         bake->bone_paths = (const char *const *)r->bone_paths;
@@ -403,6 +427,8 @@ done:
 
 void pp_labels_cleanup(pp_labels_report *r)
 {
+    free(r->volume), free(r->volume_intensity), free(r->volume_labels);
+    r->volume = NULL, r->volume_intensity = NULL, r->volume_labels = NULL;
     for (size_t i = 0; i < r->bone_count; i++)
         unlink(r->bone_paths[i]), free(r->bone_paths[i]);
     for (size_t i = 0; i < r->organ_count; i++)

@@ -59,12 +59,19 @@ typedef struct pp_labels_report {
     char absent_joints[512];   /**< template joints dropped (comma-separated) */
     pp_labels_head heads[8];
     size_t head_count;
+    /* The rest image stored in the rig (the volumes section): model-space grid,
+     * the CT's intensities (with --volume) and the labels. */
+    struct pose_rig_volume *volume; /* one entry, or NULL */
+    float *volume_intensity;
+    uint16_t *volume_labels;
 } pp_labels_report;
 
 /**
  * Read the images, build the surfaces and the filtered template into a new
  * scratch folder, and point `bake`'s skin, bones, organs and template at
- * them (pp_bake can then run). Returns 0 or a negative pose_status with a
+ * them (pp_bake can then run), and the scan itself (labels, and the CT
+ * with --volume) as the rig's rest image `scan` (the volumes section, on
+ * the scan's grid in model space). Returns 0 or a negative pose_status with a
  * message naming the file. Call pp_labels_cleanup in any case.
  */
 int pp_labels_prepare(const pp_labels_options *o, pp_bake_options *bake, pp_labels_report *r,

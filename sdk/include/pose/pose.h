@@ -432,6 +432,11 @@ typedef struct pose_rig_desc {
     /** Soft tissue's material, or NULL: the rig then has no POSE_FEM. Stored
      *  in the optional `fem` section. @since 0.2 */
     const struct pose_fem_material *fem;
+    /** Rest images (a CT and its labels: struct pose_rig_volume, pose/volume.h),
+     *  volume_count entries, or 0 / NULL. Stored in the optional `volumes`
+     *  section. @since 0.2 */
+    size_t volume_count;
+    const struct pose_rig_volume *volumes;
 } pose_rig_desc;
 
 /**

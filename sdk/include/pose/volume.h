@@ -80,6 +80,26 @@ POSE_API pose_status pose_volume_sample(pose_volume_sampler *sampler, const pose
 POSE_API size_t pose_volume_sample_bytes(const pose_volume_sampler *sampler, int intensity,
                                          int labels);
 
+/* ----------------------------------------------- rest images in the rig */
+
+/** A rest image stored in a rig (pose_rig_desc.volumes; the optional
+ *  `volumes` section, docs/rig-format.md): a name, its grid (index ->
+ *  model) and either array or both. In a loaded rig the arrays point into
+ *  the rig's storage. */
+typedef struct pose_rig_volume {
+    const char *name;          /**< 1..63 bytes, unique among the rig's volumes */
+    pose_volume_grid grid;     /**< at most 2^31 voxels */
+    const float *intensity;    /**< nx*ny*nz finite values, or NULL */
+    const uint16_t *labels;    /**< nx*ny*nz label ids, or NULL */
+} pose_rig_volume;
+
+/** Number of rest images the rig holds (0 for rigs without a volumes section). @since 0.2 */
+POSE_API size_t pose_rig_volume_count(const pose_rig *rig);
+
+/** Rest image `index` of the rig (pointers into the rig, valid while it lives);
+ *  POSE_ERR_INVALID_ARGUMENT for an index out of range. @since 0.2 */
+POSE_API pose_status pose_rig_get_volume(const pose_rig *rig, size_t index, pose_rig_volume *out);
+
 #ifdef __cplusplus
 }
 #endif
