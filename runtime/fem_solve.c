@@ -4,8 +4,8 @@
 
 #include <math.h>
 #include <string.h>
-#include <time.h>
 
+#include "rt_thread.h"
 #include "rt_vec.h"
 
 static size_t align64(size_t n)
@@ -17,6 +17,7 @@ size_t pose__fem_work_size(const pose__fem_mesh *m)
 {
     return align64(20 * m->tet_count * sizeof(float)) + align64(4 * m->tet_count * sizeof(float)) +
            align64(12 * m->tet_count * sizeof(float)) +
+           align64(24 * m->tet_count * sizeof(float)) + align64(6 * m->vertex_count * sizeof(float)) +
            5 * align64(3 * m->vertex_count * sizeof(float)) +
            align64(3 * m->surface.vertex_count * sizeof(float)) +
            align64(4 * m->chunk_count * sizeof(double));
@@ -42,6 +43,10 @@ void pose__fem_work_init(const pose__fem_mesh *m, void *memory, pose__fem_work *
     off += align64(4 * m->tet_count * sizeof(float));
     w->corner = (float *)(b + off);
     off += align64(12 * m->tet_count * sizeof(float));
+    w->dblk = (float *)(b + off);
+    off += align64(24 * m->tet_count * sizeof(float));
+    w->pre = (float *)(b + off);
+    off += align64(6 * m->vertex_count * sizeof(float));
     float **vec[5] = {&w->r, &w->z, &w->p, &w->ap, &w->gvol};
     for (int i = 0; i < 5; i++) {
         *vec[i] = (float *)(b + off);
@@ -231,6 +236,40 @@ typedef struct solve_ctx {
 
 static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const float *x, size_t t0);
 
+/* The 3x3 diagonal blocks of K at the tet's corners (symmetric, 6 floats:
+ * xx xy xz yy yz zz): moving corner k by d alone gives G = d g^T, whose
+ * energy is V mu (|g|^2 |d|^2 + (d . R g)^2 / 3) / 2 (deviatoric) +
+ * V kappa (d . C g)^2 / 2, so the block is
+ * V mu (|g|^2 I + w w^T / 3) + V kappa c c^T with w = R g, c = C g. Block
+ * Jacobi with them follows each tet's rotation and its volume direction,
+ * which a rotation-free diagonal cannot: the stiff volume terms of a near
+ * incompressible material are what slows CG. */
+static void tet_blocks(const pose__fem_tet *t, const float *rot, float *out)
+{
+    const float *R = rot, *C = rot + 9;
+    for (int k = 0; k < 4; k++) {
+        float g[3];
+        if (k == 0)
+            for (int a = 0; a < 3; a++)
+                g[a] = -(t->b[a] + t->b[3 + a] + t->b[6 + a]);
+        else
+            for (int a = 0; a < 3; a++)
+                g[a] = t->b[3 * (k - 1) + a];
+        float wv[3], cv[3];
+        for (int r = 0; r < 3; r++) {
+            wv[r] = R[3 * r] * g[0] + R[3 * r + 1] * g[1] + R[3 * r + 2] * g[2];
+            cv[r] = C[3 * r] * g[0] + C[3 * r + 1] * g[1] + C[3 * r + 2] * g[2];
+        }
+        const float gg = t->vmu * (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+        const float m3 = t->vmu / 3.0f;
+        static const int ij[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
+        for (int e = 0; e < 6; e++) {
+            int i = ij[e][0], j = ij[e][1];
+            out[6 * k + e] = (i == j ? gg : 0.0f) + m3 * wv[i] * wv[j] + t->vkappa * cv[i] * cv[j];
+        }
+    }
+}
+
 static void tets_rotate(solve_ctx *c, size_t b, size_t e)
 {
     const pose__fem_tet *tets = c->mesh->tets;
@@ -238,10 +277,13 @@ static void tets_rotate(solve_ctx *c, size_t b, size_t e)
     size_t t = b;
     for (; t + 8 <= e; t += 8)
         rotate_block(tets, w, c->x, t);
+    for (size_t u = b; u < t; u++)
+        tet_blocks(&tets[u], w->rot + 20 * u, w->dblk + 24 * u);
     for (; t < e; t++) {
         float F[9], *rot = w->rot + 20 * t;
         tet_linearize(&tets[t], c->x, w->quat + 4 * t, rot, F);
         tet_corners(&tets[t], rot, rot + 9, rot[18], F, 1, w->corner + 12 * t);
+        tet_blocks(&tets[t], rot, w->dblk + 24 * t);
     }
 }
 
@@ -484,6 +526,42 @@ static inline void gather(const pose__fem_mesh *m, const float *corner, size_t v
     out[2] = s[2];
 }
 
+/* The inverse of vertex v's diagonal block (symmetric, 6 floats), or zero
+ * for a held vertex. Falls back to the rotation-free diagonal when the
+ * block is singular (a vertex of flat tets only). */
+static void vertex_preconditioner(const pose__fem_mesh *m, const float *dblk, size_t v, float *pre)
+{
+    double k[6] = {0, 0, 0, 0, 0, 0};
+    for (uint32_t i = m->corner_offset[v]; i < m->corner_offset[v + 1]; i++) {
+        const float *b = dblk + 6 * (size_t)m->corners[i];
+        for (int e = 0; e < 6; e++)
+            k[e] += b[e];
+    }
+    const double c00 = k[3] * k[5] - k[4] * k[4], c01 = k[2] * k[4] - k[1] * k[5],
+                 c02 = k[1] * k[4] - k[2] * k[3];
+    const double det = k[0] * c00 + k[1] * c01 + k[2] * c02;
+    const float id = m->inv_diag[v];
+    if (id == 0.0f || !(det > 1e-30 * k[0] * k[3] * k[5])) {
+        pre[0] = pre[3] = pre[5] = id;
+        pre[1] = pre[2] = pre[4] = 0.0f;
+        return;
+    }
+    const double s = 1.0 / det;
+    pre[0] = (float)(c00 * s);
+    pre[1] = (float)(c01 * s);
+    pre[2] = (float)(c02 * s);
+    pre[3] = (float)((k[0] * k[5] - k[2] * k[2]) * s);
+    pre[4] = (float)((k[1] * k[2] - k[0] * k[4]) * s);
+    pre[5] = (float)((k[0] * k[3] - k[1] * k[1]) * s);
+}
+
+static inline void apply_pre(const float *pre, const float r[3], float z[3])
+{
+    z[0] = pre[0] * r[0] + pre[1] * r[1] + pre[2] * r[2];
+    z[1] = pre[1] * r[0] + pre[3] * r[1] + pre[4] * r[2];
+    z[2] = pre[2] * r[0] + pre[4] * r[1] + pre[5] * r[2];
+}
+
 static void vertices_pass(solve_ctx *c, size_t chunk)
 {
     const pose__fem_mesh *m = c->mesh;
@@ -499,11 +577,15 @@ static void vertices_pass(solve_ctx *c, size_t chunk)
         if (c->pass == PASS_GATHER_RESIDUAL) {
             float f[3];
             gather(m, w->corner, v, f);
+            float *pre = w->pre + 6 * v;
+            vertex_preconditioner(m, w->dblk, v, pre);
             for (int a = 0; a < 3; a++) {
                 r[a] = id > 0.0f ? f[a] + m->mass[v] * c->prm->gravity[a] + c->vol_force * gv[a]
                                  : 0.0f;
-                z[a] = id * r[a];
                 p[a] = 0.0f;
+            }
+            apply_pre(pre, r, z);
+            for (int a = 0; a < 3; a++) {
                 s0 += (double)r[a] * z[a];
                 s1 += (double)r[a] * r[a];
             }
@@ -525,7 +607,9 @@ static void vertices_pass(solve_ctx *c, size_t chunk)
                 /* the volume term's rank-one product: kappa_g (g . p) g */
                 float apv = id > 0.0f ? ap[a] + c->vol_product * gv[a] : 0.0f;
                 r[a] -= c->alpha * apv;
-                z[a] = id * r[a];
+            }
+            apply_pre(w->pre + 6 * v, r, z);
+            for (int a = 0; a < 3; a++) {
                 s0 += (double)r[a] * z[a];
                 s1 += (double)r[a] * r[a];
             }
@@ -630,9 +714,7 @@ static double volume_gradient(const pose__fem_mesh *m, pose__fem_work *w, const 
 
 static double now(void)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    return 1e-9 * (double)pose__now_ns();
 }
 
 void pose__fem_solve(const pose__fem_mesh *m, pose__fem_work *w, pose__pool *pool,

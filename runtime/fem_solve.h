@@ -37,6 +37,8 @@ typedef struct pose__fem_work {
     float *rot;      /**< 20 per tet: rotation, cofactor of F (row-major), J - 1, pad */
     float *quat;     /**< 4 per tet: last rotation, where the next polar decomposition starts */
     float *corner;   /**< 12 per tet: corner forces of the last pass */
+    float *dblk;     /**< 24 per tet: the corners' 3x3 stiffness blocks (6 each) */
+    float *pre;      /**< 6 per vertex: inverse diagonal block (block Jacobi) */
     float *r, *z, *p, *ap; /**< 3 per vertex */
     float *gvol;     /**< 3 per vertex: gradient of the surface's volume */
     float *sgrad;    /**< 3 per surface vertex: the same per surface vertex */
