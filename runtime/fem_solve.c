@@ -60,6 +60,13 @@ void pose__fem_work_init(const pose__fem_mesh *m, void *memory, pose__fem_work *
 
 /* ------------------------------------------------------------ per tet */
 
+/* Steps of the rotation extraction per tet and pass in the solver. Most
+ * tets converge in 3-6 from the last rotation; a block of 8 runs as long as
+ * its slowest lane, and a tet that has not converged (a fresh state, a
+ * tet sheared hard) goes on from where it stopped at the next outer
+ * iteration or frame. pose__fem_forces (tests) runs to convergence. */
+#define FEM_POLAR_STEPS 8
+
 static void quat_to_mat(const float q[4], float R[9])
 {
     float x = q[0], y = q[1], z = q[2], s = q[3];
@@ -80,9 +87,9 @@ static void quat_to_mat(const float q[4], float R[9])
  * polar decomposition by SVD or Newton iteration, it always returns a
  * rotation, also for flat and inverted tets, and warm-started it converges
  * in one or two iterations between outer iterations and frames. */
-static void extract_rotation(const float A[9], float q[4], float R[9])
+static void extract_rotation(const float A[9], float q[4], float R[9], int steps)
 {
-    for (int it = 0; it < 24; it++) {
+    for (int it = 0; it < steps; it++) {
         quat_to_mat(q, R);
         float om[3] = {0, 0, 0}, d = 0.0f;
         for (int c = 0; c < 3; c++) {
@@ -212,10 +219,10 @@ static inline void tet_corners(const pose__fem_tet *t, const float R[9], const f
 
 /* Rotation, cofactor and J - 1 of one tet at x, stored in rot[20]. */
 static inline void tet_linearize(const pose__fem_tet *t, const float *x, float *q, float *rot,
-                                 float F[9])
+                                 float F[9], int steps)
 {
     tet_gradient(t, x, F);
-    extract_rotation(F, q, rot);
+    extract_rotation(F, q, rot, steps);
     rot[18] = cofactor(F, rot + 9) - 1.0f;
 }
 
@@ -281,7 +288,7 @@ static void tets_rotate(solve_ctx *c, size_t b, size_t e)
         tet_blocks(&tets[u], w->rot + 20 * u, w->dblk + 24 * u);
     for (; t < e; t++) {
         float F[9], *rot = w->rot + 20 * t;
-        tet_linearize(&tets[t], c->x, w->quat + 4 * t, rot, F);
+        tet_linearize(&tets[t], c->x, w->quat + 4 * t, rot, F, FEM_POLAR_STEPS);
         tet_corners(&tets[t], rot, rot + 9, rot[18], F, 1, w->corner + 12 * t);
         tet_blocks(&tets[t], rot, w->dblk + 24 * t);
     }
@@ -382,7 +389,7 @@ static POSE__INLINE void quat_to_mat_block(const pose__v8f q[4], pose__v8f R[9])
  * the R made from it) while the others iterate. */
 static void rotation_block(const pose__v8f A[9], pose__v8f q[4], pose__v8f R[9])
 {
-    for (int it = 0; it < 24; it++) {
+    for (int it = 0; it < FEM_POLAR_STEPS; it++) {
         quat_to_mat_block(q, R);
         pose__v8f om[3] = {V8_SPLAT(0.0f), V8_SPLAT(0.0f), V8_SPLAT(0.0f)}, d = V8_SPLAT(0.0f);
         for (int c = 0; c < 3; c++) {
@@ -772,7 +779,7 @@ void pose__fem_forces(const pose__fem_mesh *m, pose__fem_work *w, const float *x
 {
     for (size_t t = 0; t < m->tet_count; t++) {
         float F[9], *rot = w->rot + 20 * t;
-        tet_linearize(&m->tets[t], x, w->quat + 4 * t, rot, F);
+        tet_linearize(&m->tets[t], x, w->quat + 4 * t, rot, F, 64);
         tet_corners(&m->tets[t], rot, rot + 9, rot[18], F, 1, w->corner + 12 * t);
     }
     for (size_t v = 0; v < m->vertex_count; v++)
