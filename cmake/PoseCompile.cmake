@@ -41,3 +41,28 @@ if(POSE_FUZZ)
 endif()
 
 find_package(Threads REQUIRED)
+
+# The platform files: <name>_posix.c or <name>_win32.c (runtime/rt_thread_*,
+# sdk/src/platform_map_*); a source folder's glob drops both and adds the one
+# pose_platform_sources names. Windows builds use Win32 threads, never winpthreads.
+if(WIN32)
+  set(POSE_PLATFORM win32)
+  # mingw-w64's C99 printf family (%zu, %lld), not msvcrt's. To mingw's gcc
+  # format(printf) still names msvcrt's, so it would reject %zu: format
+  # strings are checked by the Linux builds.
+  add_compile_definitions(__USE_MINGW_ANSI_STDIO=1)
+  list(APPEND POSE_WARNING_FLAGS -Wno-format)
+  set(POSE_THREAD_LIBS "")
+else()
+  set(POSE_PLATFORM posix)
+  set(POSE_THREAD_LIBS Threads::Threads)
+endif()
+# pose_platform_sources(<list var> <dir> <name>...): filter <list var> to this platform.
+function(pose_platform_sources var dir)
+  set(sources ${${var}})
+  list(FILTER sources EXCLUDE REGEX "_(posix|win32)\\.c$")
+  foreach(name IN LISTS ARGN)
+    list(APPEND sources "${dir}/${name}_${POSE_PLATFORM}.c")
+  endforeach()
+  set(${var} ${sources} PARENT_SCOPE)
+endfunction()

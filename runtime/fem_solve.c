@@ -4,8 +4,8 @@
 
 #include <math.h>
 #include <string.h>
-#include <time.h>
 
+#include "rt_thread.h"
 #include "rt_vec.h"
 
 static size_t align64(size_t n)
@@ -721,9 +721,7 @@ static double volume_gradient(const pose__fem_mesh *m, pose__fem_work *w, const 
 
 static double now(void)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    return 1e-9 * (double)pose__now_ns();
 }
 
 void pose__fem_solve(const pose__fem_mesh *m, pose__fem_work *w, pose__pool *pool,

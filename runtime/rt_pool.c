@@ -1,10 +1,10 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 #include "rt_pool.h"
 
-#include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>
-#include <time.h>
+
+#include "rt_thread.h"
 
 /* How long a thread polls before it sleeps on a condition variable. A
  * futex wake-up costs 10 us on bare metal and ~100 us where the idle core
@@ -18,13 +18,13 @@
 struct pose__worker {
     pose__pool *pool;
     unsigned part;
-    pthread_t thread;
+    pose__thread thread;
 };
 
 struct pose__pool {
-    pthread_mutex_t lock;
-    pthread_cond_t start;         /* signalled when a new task (generation) is posted */
-    pthread_cond_t done;          /* signalled when the last worker finishes */
+    pose__mutex lock;
+    pose__cond start;             /* signalled when a new task (generation) is posted */
+    pose__cond done;              /* signalled when the last worker finishes */
     unsigned threads;
     _Atomic unsigned pending;     /* workers still running the current task */
     _Atomic uint64_t generation;  /* task counter: a worker runs each generation once */
@@ -48,24 +48,17 @@ static inline void cpu_relax(void)
 #endif
 }
 
-static int64_t now_ns(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (int64_t)t.tv_sec * 1000000000 + t.tv_nsec;
-}
-
 /* Poll until *gen differs from seen (1) or SPIN_NS pass (0). */
 static int spin_for_generation(pose__pool *p, uint64_t seen)
 {
-    const int64_t deadline = now_ns() + SPIN_NS;
+    const int64_t deadline = pose__now_ns() + SPIN_NS;
     for (;;) {
         for (int i = 0; i < SPIN_CHECK; i++) {
             if (atomic_load_explicit(&p->generation, memory_order_acquire) != seen)
                 return 1;
             cpu_relax();
         }
-        if (now_ns() > deadline)
+        if (pose__now_ns() > deadline)
             return 0;
     }
 }
@@ -73,14 +66,14 @@ static int spin_for_generation(pose__pool *p, uint64_t seen)
 /* Poll until every worker is done (1) or SPIN_NS pass (0). */
 static int spin_for_done(pose__pool *p)
 {
-    const int64_t deadline = now_ns() + SPIN_NS;
+    const int64_t deadline = pose__now_ns() + SPIN_NS;
     for (;;) {
         for (int i = 0; i < SPIN_CHECK; i++) {
             if (atomic_load_explicit(&p->pending, memory_order_acquire) == 0)
                 return 1;
             cpu_relax();
         }
-        if (now_ns() > deadline)
+        if (pose__now_ns() > deadline)
             return 0;
     }
 }
@@ -92,10 +85,10 @@ static void *worker_main(void *arg)
     uint64_t seen = 0;
     for (;;) {
         if (!spin_for_generation(p, seen)) {
-            pthread_mutex_lock(&p->lock);
+            pose__mutex_lock(&p->lock);
             while (atomic_load_explicit(&p->generation, memory_order_acquire) == seen)
-                pthread_cond_wait(&p->start, &p->lock);
-            pthread_mutex_unlock(&p->lock);
+                pose__cond_wait(&p->start, &p->lock);
+            pose__mutex_unlock(&p->lock);
         }
         if (atomic_load_explicit(&p->stop, memory_order_acquire))
             break;
@@ -103,9 +96,9 @@ static void *worker_main(void *arg)
         p->fn(p->ctx, w->part, p->threads);
         if (atomic_fetch_sub_explicit(&p->pending, 1, memory_order_acq_rel) == 1) {
             /* under the lock: the caller may be between its check and its wait */
-            pthread_mutex_lock(&p->lock);
-            pthread_cond_signal(&p->done);
-            pthread_mutex_unlock(&p->lock);
+            pose__mutex_lock(&p->lock);
+            pose__cond_signal(&p->done);
+            pose__mutex_unlock(&p->lock);
         }
     }
     return NULL;
@@ -115,10 +108,10 @@ static void *worker_main(void *arg)
  * and wake the sleepers; polling workers see it directly. */
 static void post(pose__pool *p)
 {
-    pthread_mutex_lock(&p->lock);
+    pose__mutex_lock(&p->lock);
     atomic_fetch_add_explicit(&p->generation, 1, memory_order_release);
-    pthread_cond_broadcast(&p->start);
-    pthread_mutex_unlock(&p->lock);
+    pose__cond_broadcast(&p->start);
+    pose__mutex_unlock(&p->lock);
 }
 
 static void stop_workers(pose__pool *p, unsigned started)
@@ -126,10 +119,10 @@ static void stop_workers(pose__pool *p, unsigned started)
     atomic_store_explicit(&p->stop, 1, memory_order_release);
     post(p);
     for (unsigned i = 0; i < started; i++)
-        pthread_join(p->workers[i].thread, NULL);
-    pthread_cond_destroy(&p->done);
-    pthread_cond_destroy(&p->start);
-    pthread_mutex_destroy(&p->lock);
+        pose__thread_join(&p->workers[i].thread);
+    pose__cond_destroy(&p->done);
+    pose__cond_destroy(&p->start);
+    pose__mutex_destroy(&p->lock);
 }
 
 int pose__pool_init(pose__pool *p, unsigned threads)
@@ -142,21 +135,21 @@ int pose__pool_init(pose__pool *p, unsigned threads)
     atomic_init(&p->stop, 0);
     p->fn = NULL;
     p->ctx = NULL;
-    if (pthread_mutex_init(&p->lock, NULL) != 0)
+    if (pose__mutex_init(&p->lock) != 0)
         return -1;
-    if (pthread_cond_init(&p->start, NULL) != 0) {
-        pthread_mutex_destroy(&p->lock);
+    if (pose__cond_init(&p->start) != 0) {
+        pose__mutex_destroy(&p->lock);
         return -1;
     }
-    if (pthread_cond_init(&p->done, NULL) != 0) {
-        pthread_cond_destroy(&p->start);
-        pthread_mutex_destroy(&p->lock);
+    if (pose__cond_init(&p->done) != 0) {
+        pose__cond_destroy(&p->start);
+        pose__mutex_destroy(&p->lock);
         return -1;
     }
     for (unsigned i = 0; i + 1 < threads; i++) {
         p->workers[i].pool = p;
         p->workers[i].part = i + 1;
-        if (pthread_create(&p->workers[i].thread, NULL, worker_main, &p->workers[i]) != 0) {
+        if (pose__thread_start(&p->workers[i].thread, worker_main, &p->workers[i]) != 0) {
             stop_workers(p, i);
             return -1;
         }
@@ -189,8 +182,8 @@ void pose__pool_run(pose__pool *p, pose__task_fn fn, void *ctx)
     fn(ctx, 0, p->threads);
     if (spin_for_done(p))
         return;
-    pthread_mutex_lock(&p->lock);
+    pose__mutex_lock(&p->lock);
     while (atomic_load_explicit(&p->pending, memory_order_acquire) > 0)
-        pthread_cond_wait(&p->done, &p->lock);
-    pthread_mutex_unlock(&p->lock);
+        pose__cond_wait(&p->done, &p->lock);
+    pose__mutex_unlock(&p->lock);
 }

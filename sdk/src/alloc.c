@@ -1,29 +1,14 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-#include <stdlib.h>
 #include <string.h>
 
 #include "alloc.h"
-
-static void *default_alloc(size_t size, size_t align, void *user)
-{
-    (void)user;
-    void *p = NULL;
-    if (align < sizeof(void *))
-        align = sizeof(void *);
-    return posix_memalign(&p, align, size) == 0 ? p : NULL;
-}
-
-static void default_free(void *ptr, void *user)
-{
-    (void)user;
-    free(ptr);
-}
+#include "platform_alloc.h"
 
 pose_allocator pose__allocator_resolve(const pose_allocator *a)
 {
     if (a && a->alloc && a->free)
         return *a;
-    pose_allocator d = {default_alloc, default_free, NULL};
+    pose_allocator d = {pose__aligned_alloc, pose__aligned_free, NULL};
     return d;
 }
 

@@ -1,10 +1,10 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* pose_rig construction from descriptions, destruction and queries. */
 #include <string.h>
-#include <sys/mman.h>
 
 #include "alloc.h"
 #include "error.h"
+#include "platform_map.h"
 #include "rig_format.h"
 #include "rig_io.h"
 
@@ -37,7 +37,7 @@ void pose_rig_free(pose_rig *rig)
     if (rig->storage == POSE__STORAGE_OWNED)
         pose__free(&a, rig->block);
     else if (rig->storage == POSE__STORAGE_MAPPED)
-        munmap(rig->block, rig->block_size);
+        pose__file_unmap(rig->block, rig->block_size);
     pose__free(&a, rig->derived);
     pose__free(&a, rig);
 }

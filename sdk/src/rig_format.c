@@ -1,9 +1,9 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* Section layouts of rig file version 1 and the CRC-32 that guards them. */
-#include <pthread.h>
 #include <stddef.h>
 
 #include "rig_format.h"
+#include "rt_thread.h"
 
 const char *pose__section_name(uint32_t type)
 {
@@ -82,7 +82,7 @@ uint64_t pose__tissue_data_size(uint64_t vertices, uint64_t triangles)
 /* Slicing-by-8: eight bytes per step; rig files reach a few hundred MB and
  * their CRCs are checked at every load. */
 static uint32_t crc_table[8][256];
-static pthread_once_t crc_once = PTHREAD_ONCE_INIT;
+static pose__once crc_once = POSE__ONCE_INIT;
 
 static void crc_init(void)
 {
@@ -99,7 +99,7 @@ static void crc_init(void)
 
 uint32_t pose__crc32(uint32_t crc, const void *data, size_t size)
 {
-    pthread_once(&crc_once, crc_init);
+    pose__call_once(&crc_once, crc_init);
     const uint8_t *p = data;
     uint32_t c = ~crc;
     while (size >= 8) {

@@ -1,16 +1,12 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* pose_rig_load*: getting a rig file's bytes (mapped, read or from the
  * caller's memory) and handing them to pose__rig_open (rig_open.c). */
-#include <errno.h>
-#include <fcntl.h>
 #include <stdio.h>
 #include <string.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "alloc.h"
 #include "error.h"
+#include "platform_map.h"
 #include "rig_format.h"
 #include "rig_io.h"
 
@@ -38,54 +34,42 @@ pose_status pose_rig_load_ex(const char *path, const pose_load_options *options,
     char name[POSE__ERROR_SIZE / 2];
     snprintf(name, sizeof name, "file '%s'", path);
 
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (fd < 0)
-        return pose__fail(POSE_ERR_IO, "%s: cannot open: %s", name, strerror(errno));
-    struct stat sb;
-    if (fstat(fd, &sb) != 0 || !S_ISREG(sb.st_mode)) {
-        close(fd);
-        return pose__fail(POSE_ERR_IO, "%s: not a regular file", name);
-    }
-    if ((uint64_t)sb.st_size > SIZE_MAX) {
-        close(fd);
+    pose__file file;
+    uint64_t file_size;
+    char why[POSE__ERROR_SIZE / 4];
+    if (pose__file_open(&file, path, &file_size, why, sizeof why) != 0)
+        return pose__fail(POSE_ERR_IO, "%s: %s", name, why);
+    if (file_size > SIZE_MAX) {
+        pose__file_close(&file);
         return pose__fail(POSE_ERR_IO, "%s: too large for this platform", name);
     }
-    size_t size = (size_t)sb.st_size;
+    size_t size = (size_t)file_size;
     if (size < POSE__RIG_HEADER_SIZE) {
-        close(fd);
+        pose__file_close(&file);
         pose__source src = {NULL, size, name, false};
         return pose__source_fail(&src, POSE_ERR_FORMAT, "header", NULL,
                                  "truncated: %zu bytes, a rig file has at least %u", size,
                                  POSE__RIG_HEADER_SIZE);
     }
     if (!(flags & POSE_LOAD_NO_MMAP)) {
-        void *map = mmap(NULL, size, PROT_READ, MAP_PRIVATE, fd, 0);
-        close(fd);
-        if (map == MAP_FAILED)
-            return pose__fail(POSE_ERR_IO, "%s: cannot map %zu bytes: %s", name, size,
-                              strerror(errno));
+        void *map = pose__file_map(&file, size, why, sizeof why);
+        pose__file_close(&file);
+        if (!map)
+            return pose__fail(POSE_ERR_IO, "%s: cannot map %zu bytes: %s", name, size, why);
         return pose__rig_open(map, size, POSE__STORAGE_MAPPED, alloc, flags, name, true, out);
     }
     uint8_t *buf = pose__alloc(alloc, size, POSE__RIG_ALIGN);
     if (!buf) {
-        close(fd);
+        pose__file_close(&file);
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "%s: cannot allocate %zu bytes", name, size);
     }
-    size_t got = 0;
-    while (got < size) {
-        ssize_t r = read(fd, buf + got, size - got);
-        if (r < 0 && errno == EINTR)
-            continue;
-        if (r <= 0) {
-            int err = r < 0 ? errno : 0;
-            close(fd);
-            pose__free(alloc, buf);
-            return pose__fail(POSE_ERR_IO, "%s: read failed at byte %zu of %zu: %s", name, got,
-                              size, err ? strerror(err) : "file shrank while reading");
-        }
-        got += (size_t)r;
+    size_t got = pose__file_read(&file, buf, size, why, sizeof why);
+    pose__file_close(&file);
+    if (got < size) {
+        pose__free(alloc, buf);
+        return pose__fail(POSE_ERR_IO, "%s: read failed at byte %zu of %zu: %s", name, got, size,
+                          why);
     }
-    close(fd);
     return pose__rig_open(buf, size, POSE__STORAGE_OWNED, alloc, flags, name, true, out);
 }
 

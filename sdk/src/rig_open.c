@@ -6,10 +6,10 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
-#include <sys/mman.h>
 
 #include "alloc.h"
 #include "error.h"
+#include "platform_map.h"
 #include "rig_format.h"
 #include "rig_io.h"
 
@@ -550,7 +550,7 @@ pose_status pose__rig_open(uint8_t *image, size_t size, pose__rig_storage storag
         if (storage == POSE__STORAGE_OWNED)
             pose__free(&a, image);
         else if (storage == POSE__STORAGE_MAPPED)
-            munmap(image, size);
+            pose__file_unmap(image, size);
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "%s: cannot allocate the rig", name);
     }
     rig->allocator = a;

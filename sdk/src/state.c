@@ -2,11 +2,11 @@
 /* pose_state: creation, threads, method, pose_apply and its outputs. */
 #include <stdbool.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "alloc.h"
 #include "error.h"
 #include "rt_fk.h"
+#include "rt_thread.h"
 #include "rt_transfer.h"
 #include "state_internal.h"
 
@@ -19,10 +19,8 @@ static unsigned resolve_threads(int threads)
 {
     if (threads > 0)
         return threads > POSE__MAX_THREADS ? POSE__MAX_THREADS : (unsigned)threads;
-    long n = sysconf(_SC_NPROCESSORS_ONLN);
-    if (n < 1)
-        n = 1;
-    return n > POSE__MAX_THREADS ? POSE__MAX_THREADS : (unsigned)n;
+    unsigned n = pose__cpu_count();
+    return n > POSE__MAX_THREADS ? POSE__MAX_THREADS : n;
 }
 
 static pose_status start_pool(pose_state *st, unsigned threads)

@@ -3,16 +3,14 @@
  * pose_apply runs between skinning and transfer. */
 #include <math.h>
 #include <string.h>
-#include <time.h>
 
 #include "error.h"
+#include "rt_thread.h"
 #include "state_internal.h"
 
 double pose__seconds(void)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    return 1e-9 * (double)pose__now_ns();
 }
 
 int pose__state_skin_method(const pose_state *st)

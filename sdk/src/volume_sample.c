@@ -14,11 +14,11 @@
 
 #include <math.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "alloc.h"
 #include "error.h"
 #include "rt_pool.h"
+#include "rt_thread.h"
 
 #define VOL_MAX_VOXELS ((uint64_t)1 << 31)
 #define VOL_MAX_THREADS 256u
@@ -124,10 +124,8 @@ pose_status pose_volume_sampler_create(const pose_rig *rig, const pose_volume_de
     if (st != POSE_OK)
         return st;
     unsigned n = threads > 0 ? (unsigned)threads : 0;
-    if (n == 0) {
-        long c = sysconf(_SC_NPROCESSORS_ONLN);
-        n = c > 0 ? (unsigned)c : 1;
-    }
+    if (n == 0)
+        n = pose__cpu_count();
     if (n > VOL_MAX_THREADS)
         n = VOL_MAX_THREADS;
 
