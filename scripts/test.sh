@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Installs dependencies, builds pose from scratch and runs the whole test
 # suite: a normal build with gcc, then the suite again built with clang under
-# ASan+UBSan, then the threaded tests (the examples' included) under TSan.
+# ASan+UBSan, then the threaded tests (the examples' included) under TSan,
+# then libpose cross-built for Windows with its tests run under wine64
+# (scripts/windows.sh: it says why it skips where mingw-w64 or wine is missing).
 # Warnings are errors in every build, so both compilers are checked. Exits non-zero on any failure.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -25,3 +27,5 @@ echo "== build with clang and test under ASan+UBSan"
 CC=clang CXX=clang++ run_suite "$root/build-asan" "" -DPOSE_SANITIZE=ON
 echo "== threaded tests under TSan (the examples' threads too)"
 run_suite "$root/build-tsan" "threads" -DPOSE_TSAN=ON
+echo "== Windows: libpose cross-built with mingw-w64, its tests under wine64"
+bash "$root/scripts/windows.sh" "$root/build-windows"
