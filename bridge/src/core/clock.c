@@ -1,22 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0 */
+/* The media clock; pb_now_ns and pb_sleep_until_ns are pb_clock_posix.c's or
+ * pb_clock_win32.c's. */
 #include "clock.h"
-
-#include <errno.h>
-#include <time.h>
-
-int64_t pb_now_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
-
-void pb_sleep_until_ns(int64_t t_ns)
-{
-    struct timespec ts = {(time_t)(t_ns / 1000000000), (long)(t_ns % 1000000000)};
-    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) == EINTR) {
-    }
-}
 
 void pb_clock_start(pb_clock *c, double speed, double media_s, int64_t now_ns)
 {

@@ -7,9 +7,9 @@
 
 #include <stdint.h>
 
-/** CLOCK_MONOTONIC in nanoseconds. */
+/** A monotonic clock in nanoseconds (CLOCK_MONOTONIC; Windows: QueryPerformanceCounter). */
 int64_t pb_now_ns(void);
-/** Sleep until CLOCK_MONOTONIC reaches t_ns (absolute; returns at once if past). */
+/** Sleep until pb_now_ns() reaches t_ns (absolute; returns at once if past). */
 void pb_sleep_until_ns(int64_t t_ns);
 
 typedef struct pb_clock {

@@ -1,27 +1,22 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 #include "runner.h"
 
-#include <pthread.h>
-#include <sched.h>
 #include <stdatomic.h>
-#if defined(__linux__)
-#include <sys/prctl.h>
-#endif
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "clock.h"
 #include "pb_math.h"
+#include "pb_thread.h"
 #include "pb_warn.h"
 
 enum { LAG_CAPACITY = 1 << 16 };
 
 struct pb_runner {
-    pthread_t thread;
-    pthread_mutex_t mu;
-    pthread_cond_t cv;
+    pb_thread thread;
+    pb_mutex mu;
+    pb_cond cv;
     int started;
     /* control, under mu */
     int stop_req, paused, seek_req, step_req, speed_req;
@@ -50,12 +45,6 @@ struct pb_runner {
     pb_warnings *warnings;   /* the starting thread's sink, the bridge thread's from then on */
 };
 
-static void abs_deadline(int64_t t_ns, struct timespec *ts)
-{
-    ts->tv_sec = (time_t)(t_ns / 1000000000);
-    ts->tv_nsec = (long)(t_ns % 1000000000);
-}
-
 static void note_tick(pb_runner *r, const pb_pose *p, int64_t lag_ns)
 {
     /* caller holds mu */
@@ -81,11 +70,11 @@ static void note_tick(pb_runner *r, const pb_pose *p, int64_t lag_ns)
 
 static void finish(pb_runner *r, pb_source_state st)
 {
-    pthread_mutex_lock(&r->mu);
+    pb_mutex_lock(&r->mu);
     r->stats.state = st;
     r->stats.running = 0;
-    pthread_cond_broadcast(&r->cv);
-    pthread_mutex_unlock(&r->mu);
+    pb_cond_broadcast(&r->cv);
+    pb_mutex_unlock(&r->mu);
 }
 
 /* Publish the back slot, record it; returns nonzero on a recording error. */
@@ -97,21 +86,12 @@ static int publish(pb_runner *r, pb_pose *back, int64_t lag_ns)
         r->status = POSE_ERR_IO;
         bad = 1;
     }
-    pthread_mutex_lock(&r->mu);
+    pb_mutex_lock(&r->mu);
     note_tick(r, back, lag_ns);
     if (bad)
         snprintf(r->stats.fault, sizeof r->stats.fault, "%.255s", r->err.message);
-    pthread_mutex_unlock(&r->mu);
+    pb_mutex_unlock(&r->mu);
     return bad;
-}
-
-/* Linux rounds timed waits up by the thread's timer slack (50 us by
- * default); ticks want their deadline, not a coalesced wake-up. */
-static void tighten_timer_slack(void)
-{
-#if defined(__linux__) && defined(PR_SET_TIMERSLACK)
-    prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
-#endif
 }
 
 /* The bridge thread's set-up: the starting thread's warning sink (a
@@ -122,14 +102,13 @@ static void tighten_timer_slack(void)
 static void apply_priority(pb_runner *r)
 {
     pb_warnings_install(r->warnings);
-    tighten_timer_slack();
+    pb_thread_precise_wakeups(); /* ticks want their deadline, not a coalesced wake-up */
     if (r->opt.rt_priority <= 0)
         return;
-    struct sched_param sp = {.sched_priority = r->opt.rt_priority > 99 ? 99 : r->opt.rt_priority};
-    int ok = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0;
-    pthread_mutex_lock(&r->mu);
+    int ok = pb_thread_realtime(r->opt.rt_priority);
+    pb_mutex_lock(&r->mu);
     r->stats.realtime = ok;
-    pthread_mutex_unlock(&r->mu);
+    pb_mutex_unlock(&r->mu);
 }
 
 static void *clip_thread(void *arg)
@@ -143,7 +122,7 @@ static void *clip_thread(void *arg)
     for (;;) {
         int stepping = 0;
         int64_t deadline = 0;
-        pthread_mutex_lock(&r->mu);
+        pb_mutex_lock(&r->mu);
         for (;;) {
             int64_t now = pb_now_ns();
             if (r->stop_req)
@@ -169,9 +148,7 @@ static void *clip_thread(void *arg)
                     deadline = now;
                     break;
                 }
-                struct timespec ts;
-                abs_deadline(now + 50000000, &ts);
-                pthread_cond_timedwait(&r->cv, &r->mu, &ts);
+                pb_cond_wait_until(&r->cv, &r->mu, now + 50000000);
                 continue;
             }
             if (r->opt.afap) {
@@ -181,13 +158,11 @@ static void *clip_thread(void *arg)
             deadline = pb_clock_wall(&r->clock, next);
             if (deadline <= now)
                 break;
-            struct timespec ts;
-            abs_deadline(deadline, &ts);
-            if (pthread_cond_timedwait(&r->cv, &r->mu, &ts) != 0 && pb_now_ns() >= deadline)
+            if (pb_cond_wait_until(&r->cv, &r->mu, deadline) != 0 && pb_now_ns() >= deadline)
                 break; /* timed out: the tick is due (commands re-checked otherwise) */
         }
         int stop = r->stop_req;
-        pthread_mutex_unlock(&r->mu);
+        pb_mutex_unlock(&r->mu);
         if (stop)
             break;
         int64_t woke = pb_now_ns();
@@ -218,7 +193,7 @@ static void note_source(pb_runner *r, int got_sample)
 {
     pb_source_state st = r->src->state;
     uint64_t drops = r->opt.count_drops ? r->opt.count_drops(r->src) : 0;
-    pthread_mutex_lock(&r->mu);
+    pb_mutex_lock(&r->mu);
     if (st != r->stats.source && (st == PB_SOURCE_STALE || st == PB_SOURCE_DISCONNECTED || st == PB_SOURCE_FAULT))
         snprintf(r->stats.fault, sizeof r->stats.fault, "%s", r->src->message);
     r->stats.source = st;
@@ -227,7 +202,7 @@ static void note_source(pb_runner *r, int got_sample)
         r->stats.samples++;
         r->stats.last_sample_ns = pb_now_ns();
     }
-    pthread_mutex_unlock(&r->mu);
+    pb_mutex_unlock(&r->mu);
     atomic_store_explicit(&r->source_state, (int)st, memory_order_release);
 }
 
@@ -238,7 +213,7 @@ static void note_source(pb_runner *r, int got_sample)
 static int64_t source_control(pb_runner *r, int64_t last_t_ns, int *stop)
 {
     int64_t seek_to = -1;
-    pthread_mutex_lock(&r->mu);
+    pb_mutex_lock(&r->mu);
     for (int was_paused = 0;;) {
         if (r->stop_req)
             break;
@@ -252,12 +227,10 @@ static int64_t source_control(pb_runner *r, int64_t last_t_ns, int *stop)
             break;
         }
         was_paused = 1;
-        struct timespec ts;
-        abs_deadline(pb_now_ns() + 50000000, &ts);
-        pthread_cond_timedwait(&r->cv, &r->mu, &ts);
+        pb_cond_wait_until(&r->cv, &r->mu, pb_now_ns() + 50000000);
     }
     *stop = r->stop_req;
-    pthread_mutex_unlock(&r->mu);
+    pb_mutex_unlock(&r->mu);
     return seek_to;
 }
 
@@ -275,9 +248,9 @@ static void *source_thread(void *arg)
         int stop;
         int64_t seek_to = r->opt.recorded ? source_control(r, last_t, &stop) : -1;
         if (!r->opt.recorded) {
-            pthread_mutex_lock(&r->mu);
+            pb_mutex_lock(&r->mu);
             stop = r->stop_req;
-            pthread_mutex_unlock(&r->mu);
+            pb_mutex_unlock(&r->mu);
         }
         if (stop)
             break;
@@ -336,8 +309,8 @@ static void runner_free(pb_runner *r)
     free(r->lq);
     free(r->lt);
     free(r->lags);
-    pthread_mutex_destroy(&r->mu);
-    pthread_cond_destroy(&r->cv);
+    pb_mutex_destroy(&r->mu);
+    pb_cond_destroy(&r->cv);
     free(r);
 }
 
@@ -347,12 +320,8 @@ static pose_status runner_new(const pb_rig_skel *rig, const pb_runner_options *o
     pb_runner *r = calloc(1, sizeof *r);
     if (!r)
         return pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "out of memory");
-    pthread_mutex_init(&r->mu, NULL);
-    pthread_condattr_t ca;
-    pthread_condattr_init(&ca);
-    pthread_condattr_setclock(&ca, CLOCK_MONOTONIC);
-    pthread_cond_init(&r->cv, &ca);
-    pthread_condattr_destroy(&ca);
+    pb_mutex_init(&r->mu);
+    pb_cond_init(&r->cv);
     if (opt)
         r->opt = *opt;
     r->rig = rig;
@@ -383,7 +352,7 @@ static pose_status runner_new(const pb_rig_skel *rig, const pb_runner_options *o
 
 static pose_status runner_launch(pb_runner *r, void *(*fn)(void *), pb_runner **out, pb_error *err)
 {
-    if (pthread_create(&r->thread, NULL, fn, r) != 0) {
+    if (pb_thread_start(&r->thread, fn, r) != 0) {
         runner_free(r);
         return pb_fail(err, POSE_ERR_THREAD, "cannot start the bridge thread");
     }
@@ -457,73 +426,71 @@ pb_source_state pb_runner_source_state(pb_runner *r)
 
 void pb_runner_stats_get(pb_runner *r, pb_runner_stats *out)
 {
-    pthread_mutex_lock(&r->mu);
+    pb_mutex_lock(&r->mu);
     *out = r->stats;
-    pthread_mutex_unlock(&r->mu);
+    pb_mutex_unlock(&r->mu);
 }
 
 void pb_runner_pause(pb_runner *r, int paused)
 {
-    pthread_mutex_lock(&r->mu);
+    pb_mutex_lock(&r->mu);
     r->paused = paused != 0;
-    pthread_cond_broadcast(&r->cv);
-    pthread_mutex_unlock(&r->mu);
+    pb_cond_broadcast(&r->cv);
+    pb_mutex_unlock(&r->mu);
 }
 
 void pb_runner_seek(pb_runner *r, double media_s)
 {
-    pthread_mutex_lock(&r->mu);
+    pb_mutex_lock(&r->mu);
     r->seek_to = media_s;
     r->seek_req = 1;
-    pthread_cond_broadcast(&r->cv);
-    pthread_mutex_unlock(&r->mu);
+    pb_cond_broadcast(&r->cv);
+    pb_mutex_unlock(&r->mu);
 }
 
 void pb_runner_step(pb_runner *r, int ticks)
 {
-    pthread_mutex_lock(&r->mu);
+    pb_mutex_lock(&r->mu);
     if (r->paused) /* steps only make sense while paused; none queue up during playback */
         r->step_req += ticks > 0 ? ticks : 0;
-    pthread_cond_broadcast(&r->cv);
-    pthread_mutex_unlock(&r->mu);
+    pb_cond_broadcast(&r->cv);
+    pb_mutex_unlock(&r->mu);
 }
 
 void pb_runner_set_speed(pb_runner *r, double speed)
 {
     if (!(speed > 0))
         return;
-    pthread_mutex_lock(&r->mu);
+    pb_mutex_lock(&r->mu);
     r->speed = speed;
     r->speed_req = 1;
-    pthread_cond_broadcast(&r->cv);
-    pthread_mutex_unlock(&r->mu);
+    pb_cond_broadcast(&r->cv);
+    pb_mutex_unlock(&r->mu);
 }
 
 int pb_runner_wait(pb_runner *r, int timeout_ms)
 {
     int64_t until = timeout_ms < 0 ? INT64_MAX : pb_now_ns() + (int64_t)timeout_ms * 1000000;
-    pthread_mutex_lock(&r->mu);
+    pb_mutex_lock(&r->mu);
     while (r->stats.running) {
         if (until == INT64_MAX) {
-            pthread_cond_wait(&r->cv, &r->mu);
+            pb_cond_wait(&r->cv, &r->mu);
         } else {
-            struct timespec ts;
-            abs_deadline(until, &ts);
-            if (pthread_cond_timedwait(&r->cv, &r->mu, &ts) != 0 && pb_now_ns() >= until)
+            if (pb_cond_wait_until(&r->cv, &r->mu, until) != 0 && pb_now_ns() >= until)
                 break;
         }
     }
     int ended = !r->stats.running;
-    pthread_mutex_unlock(&r->mu);
+    pb_mutex_unlock(&r->mu);
     return ended;
 }
 
 size_t pb_runner_lags(pb_runner *r, int64_t *out, size_t capacity)
 {
-    pthread_mutex_lock(&r->mu);
+    pb_mutex_lock(&r->mu);
     size_t n = r->lag_count < capacity ? r->lag_count : capacity;
     memcpy(out, r->lags, n * sizeof *out);
-    pthread_mutex_unlock(&r->mu);
+    pb_mutex_unlock(&r->mu);
     return n;
 }
 
@@ -531,12 +498,12 @@ pose_status pb_runner_stop(pb_runner *r, pb_error *err)
 {
     if (!r)
         return POSE_OK;
-    pthread_mutex_lock(&r->mu);
+    pb_mutex_lock(&r->mu);
     r->stop_req = 1;
-    pthread_cond_broadcast(&r->cv);
-    pthread_mutex_unlock(&r->mu);
+    pb_cond_broadcast(&r->cv);
+    pb_mutex_unlock(&r->mu);
     if (r->started)
-        pthread_join(r->thread, NULL);
+        pb_thread_join(&r->thread);
     pose_status s = r->status;
     if (s && err)
         *err = r->err;
