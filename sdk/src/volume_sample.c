@@ -358,6 +358,12 @@ static void raster_tet(const pose_volume_sampler *s, size_t t, int z0, int z1)
         i1 = nx - 1;
     if (i0 > i1)
         return;
+    /* Most small tets hold no voxel centre: the y extent says so before the
+     * matrices are set up. */
+    const float ymin = minf4(q[0][1], q[1][1], q[2][1], q[3][1]);
+    const float ymax = maxf4(q[0][1], q[1][1], q[2][1], q[3][1]);
+    if (iceil(ymin - 1e-4f) > ifloor(ymax + 1e-4f) || ymax < -1e-4f || ymin > (float)(ny - 1) + 1e-4f)
+        return;
     for (int c = 0; c < 4; c++)
         r[c] = s->rest_index + 3 * (size_t)tv[c];
     /* D = [q1-q0 q2-q0 q3-q0]; b = D^-1 (x - q0); rest = r0 + E b. */
@@ -461,7 +467,28 @@ static void raster_tet(const pose_volume_sampler *s, size_t t, int z0, int z1)
             float rz = (float)(r[0][2] + M[2][0] * xa[0] + M[2][1] * xa[1] + M[2][2] * xa[2]);
             size_t row = ((size_t)k * (size_t)ny + (size_t)j) * (size_t)nx;
             memset(s->covered + row + ia, 1, (size_t)(ib - ia + 1));
-            if (inside)
+            if (inside && dst_i && dst_l) {
+                /* The common case, both outputs: everything in registers. */
+                const float *img = rest->intensity;
+                const uint16_t *lb = rest->labels;
+                float *oi = dst_i + row;
+                uint16_t *ol = dst_l + row;
+                for (int i = ia; i <= ib; i++) {
+                    const float u = (float)(i - ia);
+                    const float x = rx + mx * u, y = ry + my * u, z = rz + mz * u;
+                    int xi = (int)x, yi = (int)y, zi = (int)z;
+                    float fx = x - (float)xi, fy = y - (float)yi, fz = z - (float)zi;
+                    size_t base = (size_t)zi * rsz + (size_t)yi * rsy + (size_t)xi;
+                    ol[i] = lb[base + (fx >= 0.5f) + (fy >= 0.5f ? rsy : 0) + (fz >= 0.5f ? rsz : 0)];
+                    const float *p = img + base;
+                    float c00 = p[0] + fx * (p[1] - p[0]);
+                    float c10 = p[rsy] + fx * (p[rsy + 1] - p[rsy]);
+                    float c01 = p[rsz] + fx * (p[rsz + 1] - p[rsz]);
+                    float c11 = p[rsz + rsy] + fx * (p[rsz + rsy + 1] - p[rsz + rsy]);
+                    float c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
+                    oi[i] = c0 + fz * (c1 - c0);
+                }
+            } else if (inside)
                 for (int i = ia; i <= ib; i++) {
                     float u = (float)(i - ia);
                     sample_rest_inside(rest, rsy, rsz, rx + mx * u, ry + my * u, rz + mz * u,
