@@ -18,12 +18,14 @@
 #include "ex_vtk.h"
 #include "ex_motion.h"
 #include "ex_scene.h"
+#include "ex_volume_nifti.h"
 
 enum { MAX_POSES = 64 };
 
 static void usage(FILE *f)
 {
-    fputs("usage: pose-export RIG [options] (--obj FILE | --ply DIR | --vtu FILE | --glb FILE | --surfaces FILE)...\n"
+    fputs("usage: pose-export RIG [options] (--obj FILE | --ply DIR | --vtu FILE | --glb FILE | --surfaces FILE |\n"
+          "                                      --nifti PREFIX)...\n"
           "       pose-export RIG --source SRC [--map MAP] (--frames A-B:STEP | --times T,...) (--pvd FILE | --gltf-anim FILE)...\n"
           "Pose a rig and write the result; or pose it at many frames of a source and write the session.\n"
           "  --pose JOINT=RX,RY,RZ   set a joint (degrees, XYZ order; repeatable)\n"
@@ -42,6 +44,8 @@ static void usage(FILE *f)
           "                          (FILE minus .pvd, then _00000.vtu ...) and the ParaView series FILE\n"
           "  --gltf-anim FILE        with --frames/--times: skin and bones as skinned meshes with the\n"
           "                          session's joint animation, one binary glTF (Blender, three.js)\n"
+          "  --nifti PREFIX          the rig's scan (pose-bake --labels) posed: PREFIX_ct.nii.gz and\n"
+          "                          PREFIX_labels.nii.gz on the scan's grid\n"
           "  --json                  print a JSON summary on stdout\n"
           "  -h, --help              this text\n",
           f);
@@ -51,6 +55,8 @@ int main(int argc, char **argv)
 {
     const char *rig = NULL, *obj = NULL, *ply = NULL, *vtu = NULL, *source = NULL, *map = NULL, *weights = NULL;
     const char *glb = NULL, *surfaces = NULL, *pvd = NULL, *anim = NULL, *frames_arg = NULL, *times_arg = NULL;
+    const char *nifti = NULL;
+    int nifti_files = 0;
     long *frames = NULL;
     double *times = NULL;
     size_t nframes = 0;
@@ -60,7 +66,8 @@ int main(int argc, char **argv)
     long frame = -1;
     char err[1024] = "";
     enum { OPT_POSE = POSE_CLI_LONG_ONLY, OPT_SOURCE, OPT_FRAME, OPT_MAP, OPT_METHOD, OPT_OBJ, OPT_PLY,
-           OPT_VTU, OPT_WEIGHTS, OPT_JSON, OPT_FRAMES, OPT_TIMES, OPT_GLB, OPT_SURFACES, OPT_PVD, OPT_ANIM };
+           OPT_VTU, OPT_WEIGHTS, OPT_JSON, OPT_FRAMES, OPT_TIMES, OPT_GLB, OPT_SURFACES, OPT_PVD, OPT_ANIM,
+           OPT_NIFTI };
     static const struct option options[] = {
         {"pose", required_argument, NULL, OPT_POSE},       {"source", required_argument, NULL, OPT_SOURCE},
         {"frame", required_argument, NULL, OPT_FRAME},     {"map", required_argument, NULL, OPT_MAP},
@@ -70,6 +77,7 @@ int main(int argc, char **argv)
         {"frames", required_argument, NULL, OPT_FRAMES},   {"times", required_argument, NULL, OPT_TIMES},
         {"glb", required_argument, NULL, OPT_GLB},         {"surfaces", required_argument, NULL, OPT_SURFACES},
         {"pvd", required_argument, NULL, OPT_PVD},         {"gltf-anim", required_argument, NULL, OPT_ANIM},
+        {"nifti", required_argument, NULL, OPT_NIFTI},
         {"help", no_argument, NULL, 'h'},                  {0}};
     pose_cli cli;
     pose_cli_begin(&cli, "pose-export", argc, argv, options);
@@ -124,6 +132,9 @@ int main(int argc, char **argv)
         case OPT_ANIM:
             anim = cli.value;
             break;
+        case OPT_NIFTI:
+            nifti = cli.value;
+            break;
         case OPT_POSE:
             if (npose == MAX_POSES) {
                 pose_cli_error(&cli, "at most %d --pose options", MAX_POSES);
@@ -145,10 +156,10 @@ int main(int argc, char **argv)
             return 2;
         }
     }
-    const int many = frames_arg || times_arg, one = obj || ply || vtu || glb || surfaces;
+    const int many = frames_arg || times_arg, one = obj || ply || vtu || glb || surfaces || nifti;
     if (!rig || (!one && !pvd && !anim)) {
         fprintf(stderr, "pose-export: need a rig and at least one of --obj, --ply, --vtu, --glb, --surfaces, "
-                        "--pvd, --gltf-anim (see --help)\n");
+                        "--nifti, --pvd, --gltf-anim (see --help)\n");
         return 2;
     }
     if ((frames_arg && times_arg) || (many && frame >= 0)) {
@@ -226,6 +237,8 @@ int main(int argc, char **argv)
     }
     if (vtu && ex_export_vtu(sc.state, vtu, wj, err, sizeof err) < 0)
         goto done;
+    if (nifti && ex_volume_write_nifti(sc.state, nifti, 0, &nifti_files, err, sizeof err) < 0)
+        goto done;
     if (json) {
         printf("{\"rig\": ");
         ex_json_string(stdout, rig);
@@ -245,9 +258,11 @@ int main(int argc, char **argv)
             printf(", \"frames\": %zu, \"first_s\": %.6f, \"last_s\": %.6f, \"apply_ms_total\": %.3f, "
                    "\"skinned_meshes\": %zu",
                    nframes, series.first_s, series.last_s, series.apply_ms, anim ? series.meshes : (size_t)0);
-        const char *keys[7] = {"obj", "ply", "vtu", "glb", "surfaces", "pvd", "gltf_anim"},
-                   *vals[7] = {obj, ply, vtu, glb, surfaces, pvd, anim};
-        for (int k = 0; k < 7; k++)
+        const char *keys[8] = {"obj", "ply", "vtu", "glb", "surfaces", "pvd", "gltf_anim", "nifti"},
+                   *vals[8] = {obj, ply, vtu, glb, surfaces, pvd, anim, nifti};
+        if (nifti)
+            printf(", \"nifti_files\": %d", nifti_files);
+        for (int k = 0; k < 8; k++)
             if (vals[k]) {
                 printf(", \"%s\": ", keys[k]);
                 ex_json_string(stdout, vals[k]);
@@ -264,6 +279,8 @@ int main(int argc, char **argv)
         if (glb || surfaces)
             printf("%s%s%s%s\n", glb ? "glTF " : "", glb ? glb : "", surfaces ? (glb ? "; surfaces " : "surfaces ") : "",
                    surfaces ? surfaces : "");
+        if (nifti)
+            printf("NIfTI: %d files %s_*.nii.gz\n", nifti_files, nifti);
     }
     rc = 0;
 done:
