@@ -77,7 +77,9 @@ if [ -f "$tmp/prefix/include/pose/bridge.h" ]; then
     hid="$src/data/hid/mannequin_sit_to_stand.hid"
     "$tmp/embed-cmake/bridge_host" "$rig" "$hid" "$map" 100 | tee "$tmp/run-bridge-cmake.log"
     grep -q "in 100 frames" "$tmp/run-bridge-cmake.log"
-    ldd "$tmp/embed-cmake/bridge_host" | grep -q "$tmp/prefix/.*libpose_bridge.so"
+    # (through a file: under pipefail, grep -q leaving early can fail the pipe with SIGPIPE)
+    ldd "$tmp/embed-cmake/bridge_host" >"$tmp/ldd-bridge.log"
+    grep -q "$tmp/prefix/.*libpose_bridge.so" "$tmp/ldd-bridge.log"
     make -s -C "$src/examples/embed" OUT="$tmp/embed-make" PKG_CONFIG="pkg-config --define-prefix" \
         CFLAGS="-O2 -Wall -Wextra -Werror" bridge_host
     "$tmp/embed-make/bridge_host" "$rig" "$hid" "$map" 100 | tee "$tmp/run-bridge-make.log"
