@@ -282,14 +282,13 @@ static void test_rest_comes_back(void **state)
     float *vi = malloc(f->n * sizeof *vi);
     uint16_t *vl = malloc(f->n * sizeof *vl);
     sample(f, st, 2, vi, vl);
-    size_t covered = 0, same = 0, labelled = 0, off = 0;
+    size_t covered = 0, same = 0, off = 0;
     double worst = 0;
     for (size_t v = 0; v < f->n; v++) {
         if (vl[v] == UNCOVERED)
             continue;
         covered++;
         same += vl[v] == f->labels[v];
-        labelled += f->labels[v] != 0;
         worst = fmax(worst, fabs(vi[v] - f->ct.data[v]));
         off += fabs(vi[v] - f->ct.data[v]) > 0.01;
     }
