@@ -17,6 +17,7 @@
 #include "bridge_test.h"
 #include "can_bus.h"
 #include "can_source.h"
+#include "clinical_check.h"
 #include "hid_mannequin.h"
 #include "hid_open.h"
 #include "mapping.h"
@@ -201,41 +202,6 @@ static void replay_pose_at(replay *r, fixture *f, double t_s)
 
 /* --------------------------------------------------- clinical angles back */
 
-/* The joint's clinical angles measured from its world rotation (not from
- * what was requested): R_j = (W_parent * rest_local_j)^-1 * W_j. */
-static void clinical_back(const fixture *f, int j, const float hint[3], float deg[3])
-{
-    pose_joint_info info;
-    pose_transform w, wp = {{0, 0, 0, 1}, {0, 0, 0}};
-    assert_int_equal(pose_rig_joint_info(f->rig, j, &info), POSE_OK);
-    assert_int_equal(pose_joint_world(f->st, j, &w), POSE_OK);
-    if (info.parent >= 0)
-        assert_int_equal(pose_joint_world(f->st, info.parent, &wp), POSE_OK);
-    double a[4], b[4], c[4], ci[4], wj[4], r[4];
-    for (int k = 0; k < 4; k++) {
-        a[k] = wp.rotation[k];
-        b[k] = info.rest_local.rotation[k];
-        wj[k] = w.rotation[k];
-    }
-    pb_quat_mul(a, b, c);
-    pb_quat_conj(c, ci);
-    pb_quat_mul(ci, wj, r);
-    float q[4] = {(float)r[0], (float)r[1], (float)r[2], (float)r[3]};
-    assert_int_equal(pose_local_to_clinical(f->rig, j, q, hint, deg), POSE_OK);
-}
-
-/* All of a joint's truth angles inside its clinical range of motion (none limited)? */
-static int in_range(const fixture *f, int j, const double truth[3])
-{
-    pose_joint_clinical c;
-    if (pose_rig_joint_clinical(f->rig, j, &c) != POSE_OK)
-        return 0;
-    for (int k = 0; k < 3; k++)
-        if ((c.limit_flags & (1u << k)) && (truth[k] < c.limit_min_deg[k] + 0.5 || truth[k] > c.limit_max_deg[k] - 0.5))
-            return 0;
-    return 1;
-}
-
 typedef struct truth_channel {
     const char *column; /* truth name */
     const char *joint;
@@ -259,10 +225,10 @@ static void compare_all(const fixture *f, const truth_channel *tab, int n, const
                 want[tab[k].dof] = truth[k];
         int j = pose_rig_find_joint(f->rig, tab[i].joint);
         assert_true(j >= 0);
-        if (!in_range(f, j, want))
+        if (!tc_in_range(f->rig, j, want))
             continue;
         float hint[3] = {(float)want[0], (float)want[1], (float)want[2]}, got[3];
-        clinical_back(f, j, hint, got);
+        tc_clinical_back(f->rig, f->st, j, hint, got);
         double e = fabs(got[tab[i].dof] - truth[i]);
         s->compared++;
         if (e > s->worst) {

@@ -19,6 +19,7 @@
 
 #include <cmocka.h>
 
+#include "clinical_check.h"
 #include "pose/bridge.h"
 #include "pose/pose.h"
 
@@ -59,47 +60,6 @@ static int teardown(void **state)
     pose_state_free(f->st);
     pose_rig_free(f->rig);
     return 0;
-}
-
-static void qmul(const double a[4], const double b[4], double o[4])
-{ /* (x, y, z, w) */
-    o[0] = a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1];
-    o[1] = a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0];
-    o[2] = a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3];
-    o[3] = a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2];
-}
-
-/* The joint's clinical angles from its world rotation: R_j = (W_parent * rest_local_j)^-1 * W_j. */
-static void clinical_back(const fixture *f, int j, const float hint[3], float deg[3])
-{
-    pose_joint_info info;
-    pose_transform w, wp = {{0, 0, 0, 1}, {0, 0, 0}};
-    assert_int_equal(pose_rig_joint_info(f->rig, j, &info), POSE_OK);
-    assert_int_equal(pose_joint_world(f->st, j, &w), POSE_OK);
-    if (info.parent >= 0)
-        assert_int_equal(pose_joint_world(f->st, info.parent, &wp), POSE_OK);
-    double a[4], b[4], c[4], wj[4], r[4];
-    for (int k = 0; k < 4; k++) {
-        a[k] = wp.rotation[k];
-        b[k] = info.rest_local.rotation[k];
-        wj[k] = w.rotation[k];
-    }
-    qmul(a, b, c);
-    c[0] = -c[0], c[1] = -c[1], c[2] = -c[2];
-    qmul(c, wj, r);
-    float q[4] = {(float)r[0], (float)r[1], (float)r[2], (float)r[3]};
-    assert_int_equal(pose_local_to_clinical(f->rig, j, q, hint, deg), POSE_OK);
-}
-
-static int in_range(const fixture *f, int j, const double truth[3])
-{
-    pose_joint_clinical c;
-    if (pose_rig_joint_clinical(f->rig, j, &c) != POSE_OK)
-        return 0;
-    for (int k = 0; k < 3; k++)
-        if ((c.limit_flags & (1u << k)) && (truth[k] < c.limit_min_deg[k] + 0.5 || truth[k] > c.limit_max_deg[k] - 0.5))
-            return 0;
-    return 1;
 }
 
 /* "knee_l.flexion" -> joint "knee_l", angle 0 (flexion, dorsiflexion) or 1 (abduction) */
@@ -163,10 +123,10 @@ static void truth_run(fixture *f, const char *capture, const char *truth_file, s
             }
             int j = pose_rig_find_joint(f->rig, joint);
             assert_true(j >= 0);
-            if (!in_range(f, j, want))
+            if (!tc_in_range(f->rig, j, want))
                 continue;
             float hint[3] = {(float)want[0], (float)want[1], (float)want[2]}, got[3];
-            clinical_back(f, j, hint, got);
+            tc_clinical_back(f->rig, f->st, j, hint, got);
             double e = fabs(got[dof] - v[i]);
             s->compared++;
             if (e > s->worst) {
