@@ -65,4 +65,7 @@ fi
 echo "== windows: tests under $wine"
 # A prefix of the build's own; no Mono/Gecko installers, no debug chatter.
 export WINEPREFIX="$dir/wine" WINEDEBUG=-all WINEDLLOVERRIDES="mscoree,mshtml="
+# Make the prefix before the tests run in parallel: two wine processes that
+# both find no prefix race to create it, and one of them fails.
+"$wine" wineboot --init >/dev/null 2>&1 || true
 ctest --test-dir "$dir" --output-on-failure -j "$jobs"
