@@ -17,6 +17,7 @@
 #include "hid_replay.h"
 #include "hid_report.h"
 #include "mapping.h"
+#include "clock.h"
 
 #ifndef POSE_SOURCE_DIR_DEFAULT
 #define POSE_SOURCE_DIR_DEFAULT "."
@@ -88,15 +89,15 @@ int main(int argc, char **argv)
     const int passes = 50;
     size_t n = rec->event_count;
     double sink = 0;
-    int64_t t0 = pb_hid_now_ns();
+    int64_t t0 = pb_now_ns();
     for (int p = 0; p < passes; p++)
         for (size_t i = 0; i < n; i++) {
             uint32_t first, count;
             pb_hid_report_decode(d, rec->data + rec->events[i].offset, rec->events[i].len, lg, val, ok, &first, &count);
             sink += val[0];
         }
-    double decode_ns = (double)(pb_hid_now_ns() - t0) / (double)(passes * n);
-    t0 = pb_hid_now_ns();
+    double decode_ns = (double)(pb_now_ns() - t0) / (double)(passes * n);
+    t0 = pb_now_ns();
     for (int p = 0; p < passes; p++)
         for (size_t i = 0; i < n; i++) {
             uint32_t first, count;
@@ -113,7 +114,7 @@ int main(int argc, char **argv)
             pb_chanmap_pose(cm, &pose);
             sink += pose.q[17][1];
         }
-    double map_ns = (double)(pb_hid_now_ns() - t0) / (double)(passes * n);
+    double map_ns = (double)(pb_now_ns() - t0) / (double)(passes * n);
 
     /* Whole source path (replay transport + state machine + decoder + map), as fast as possible. */
     pb_hid_recording *rec60;
@@ -126,19 +127,19 @@ int main(int argc, char **argv)
     FILE *tf = fd >= 0 ? fdopen(fd, "w") : NULL;
     if (!tf)
         die("temporary file", NULL);
-    t0 = pb_hid_now_ns();
+    t0 = pb_now_ns();
     int werr = pb_hid_recorder_write_device(tf, -1, &rec60->devices[0]);
     for (size_t i = 0; !werr && i < rec60->event_count; i++)
         werr = pb_hid_recorder_write_event(tf, rec60->events[i].t_ns, rec60->data + rec60->events[i].offset,
                                            rec60->events[i].len);
     if (fclose(tf) != 0 || werr)
         die("writing the recording", NULL);
-    double write_s = (double)(pb_hid_now_ns() - t0) * 1e-9;
+    double write_s = (double)(pb_now_ns() - t0) * 1e-9;
     pb_hid_recording *back;
-    t0 = pb_hid_now_ns();
+    t0 = pb_now_ns();
     if (pb_hid_recording_load(tmp_path, &back, &err) != POSE_OK)
         die("reading the recording", &err);
-    double read_s = (double)(pb_hid_now_ns() - t0) * 1e-9;
+    double read_s = (double)(pb_now_ns() - t0) * 1e-9;
     FILE *sz = fopen(tmp_path, "rb");
     double mb = 0;
     if (sz) {
@@ -158,7 +159,7 @@ int main(int argc, char **argv)
     size_t got = 0, dropped = 0, reordered = 0;
     int64_t last_t = -1;
     long last_seq = -1;
-    t0 = pb_hid_now_ns();
+    t0 = pb_now_ns();
     while (pb_source_read(src, &u, 100) == 1) {
         long seq = (long)u.values[17];
         if (last_seq >= 0 && seq != ((last_seq + 1) & 0xFFFF)) {
@@ -175,7 +176,7 @@ int main(int argc, char **argv)
         pb_chanmap_pose(cm, &pose);
         got++;
     }
-    double replay_s = (double)(pb_hid_now_ns() - t0) * 1e-9;
+    double replay_s = (double)(pb_now_ns() - t0) * 1e-9;
     pb_source_destroy(src);
 
     /* 3. Recorded timing: lateness of each report against its schedule. */
@@ -193,7 +194,7 @@ int main(int argc, char **argv)
          * (arrival - recorded time) marks the schedule; lateness is measured from it. */
         double earliest = 1e300;
         while (pb_source_read(rs, &u, 100) == 1) {
-            late[rt_n] = (double)(pb_hid_now_ns() - u.t_ns) * 1e-3; /* us */
+            late[rt_n] = (double)(pb_now_ns() - u.t_ns) * 1e-3; /* us */
             earliest = late[rt_n] < earliest ? late[rt_n] : earliest;
             rt_n++;
         }

@@ -21,6 +21,7 @@
 #include "usb_gonio.h"
 #include "usb_source.h"
 #include "usbmon.h"
+#include "clock.h"
 
 #ifndef POSE_SOURCE_DIR_DEFAULT
 #define POSE_SOURCE_DIR_DEFAULT "."
@@ -54,7 +55,7 @@ static run replay(const char *path, const pb_usb_layout *l, pb_chanmap *cm, pb_p
     run r = {0};
     double *late = afap ? NULL : malloc((size_t)(seconds * 1100 + 16) * sizeof *late);
     double earliest = 1e300;
-    int64_t last_t = -1, t0 = pb_usb_now_ns();
+    int64_t last_t = -1, t0 = pb_now_ns();
     pb_update u;
     for (;;) {
         int k = pb_source_read(src, &u, 200);
@@ -66,7 +67,7 @@ static run replay(const char *path, const pb_usb_layout *l, pb_chanmap *cm, pb_p
             r.reordered++;
         last_t = u.t_ns;
         if (late) {
-            late[r.frames] = (double)(pb_usb_now_ns() - u.t_ns) * 1e-3;
+            late[r.frames] = (double)(pb_now_ns() - u.t_ns) * 1e-3;
             earliest = late[r.frames] < earliest ? late[r.frames] : earliest;
         }
         pb_chanmap_update(cm, &u);
@@ -75,7 +76,7 @@ static run replay(const char *path, const pb_usb_layout *l, pb_chanmap *cm, pb_p
         if (!afap && (double)u.t_ns * 1e-9 >= seconds)
             break;
     }
-    r.seconds = (double)(pb_usb_now_ns() - t0) * 1e-9;
+    r.seconds = (double)(pb_now_ns() - t0) * 1e-9;
     r.drops = pb_usb_source_drops(src);
     pb_source_destroy(src);
     if (late && r.frames) {
@@ -131,16 +132,16 @@ int main(int argc, char **argv)
     FILE *f = fd >= 0 ? fdopen(fd, "w") : NULL;
     if (!f)
         die("temporary file", NULL);
-    int64_t t0 = pb_usb_now_ns();
+    int64_t t0 = pb_now_ns();
     long sent = pb_gonio_write_capture(f, PB_MOTION_ARM_RAISE, 1000.0, 60.0, 17, NULL);
     if (fclose(f) != 0 || sent != 60000)
         die("writing the capture", NULL);
-    double write_s = (double)(pb_usb_now_ns() - t0) * 1e-9;
+    double write_s = (double)(pb_now_ns() - t0) * 1e-9;
     pb_usbmon_capture *cap;
-    t0 = pb_usb_now_ns();
+    t0 = pb_now_ns();
     if (pb_usbmon_load(tmp, &cap, &err) != POSE_OK)
         die("reading the capture", &err);
-    double read_s = (double)(pb_usb_now_ns() - t0) * 1e-9;
+    double read_s = (double)(pb_now_ns() - t0) * 1e-9;
     FILE *sz = fopen(tmp, "rb");
     double mb = 0;
     if (sz) {
@@ -159,14 +160,14 @@ int main(int argc, char **argv)
     if (!frames || nframes != 60000 || pb_usb_decoder_init(&dec, &layout, &err) != POSE_OK)
         die("frames", &err);
     /* decode alone, in bulk (no per-frame clock reads) */
-    int64_t d0 = pb_usb_now_ns();
+    int64_t d0 = pb_now_ns();
     for (int p = 0; p < 5; p++) {
         pb_usb_decoder_resync(&dec);
         for (size_t i = 0; i < nframes; i++)
             if (pb_usb_decode(&dec, frames[i], 32, NULL) != PB_USB_DECODE_OK)
                 die("a frame did not decode", NULL);
     }
-    double decode_ns = (double)(pb_usb_now_ns() - d0) / (5.0 * (double)nframes);
+    double decode_ns = (double)(pb_now_ns() - d0) / (5.0 * (double)nframes);
     const int passes = 3;
     double *ns = malloc((size_t)passes * nframes * sizeof *ns);
     uint32_t idx[PB_USB_MAX_CHANNELS];
@@ -174,21 +175,21 @@ int main(int argc, char **argv)
         idx[c] = (uint32_t)c;
     double sink = 0;
     size_t k = 0;
-    int64_t all0 = pb_usb_now_ns();
+    int64_t all0 = pb_now_ns();
     for (int p = 0; p < passes; p++) {
         pb_usb_decoder_resync(&dec);
         for (size_t i = 0; i < nframes; i++, k++) {
-            int64_t a = pb_usb_now_ns();
+            int64_t a = pb_now_ns();
             if (pb_usb_decode(&dec, frames[i], 32, NULL) != PB_USB_DECODE_OK)
                 die("a frame did not decode", NULL);
             pb_update u = {(int64_t)(p * 60000 + (long)i) * 1000000, layout.channel_count, idx, dec.values};
             pb_chanmap_update(cm, &u);
             pb_chanmap_pose(cm, &pose);
-            ns[k] = (double)(pb_usb_now_ns() - a);
+            ns[k] = (double)(pb_now_ns() - a);
             sink += pose.q[1][0];
         }
     }
-    double mean_ns = (double)(pb_usb_now_ns() - all0) / (double)k;
+    double mean_ns = (double)(pb_now_ns() - all0) / (double)k;
     qsort(ns, k, sizeof *ns, cmp_double);
     double p50 = ns[k / 2], p99 = ns[k * 99 / 100];
     pb_usb_decoder_free(&dec);

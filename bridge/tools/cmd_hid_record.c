@@ -9,6 +9,7 @@
 #include "hid_open.h"
 #include "pose_bridge_cli.h"
 #include "pose_cli.h"
+#include "clock.h"
 
 static volatile sig_atomic_t stop;
 
@@ -106,7 +107,7 @@ static int run(int argc, char **argv)
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
     int tty = isatty(STDERR_FILENO);
-    int64_t t0 = pb_hid_now_ns(), last_progress = 0;
+    int64_t t0 = pb_now_ns(), last_progress = 0;
     long reports = 0;
     int rc = 0;
     while (!stop) {
@@ -120,7 +121,7 @@ static int run(int argc, char **argv)
             break;
         }
         reports += r;
-        int64_t now = pb_hid_now_ns();
+        int64_t now = pb_now_ns();
         double el = (double)(now - t0) * 1e-9;
         if (tty && now - last_progress > 250000000) {
             last_progress = now;

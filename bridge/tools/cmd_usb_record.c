@@ -11,6 +11,7 @@
 #include "pose_bridge_cli.h"
 #include "pose_cli.h"
 #include "usb_source.h"
+#include "clock.h"
 
 static volatile sig_atomic_t stop;
 
@@ -112,7 +113,7 @@ static int run(int argc, char **argv)
     src->on_status = on_status;
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
-    int64_t t0 = pb_usb_now_ns();
+    int64_t t0 = pb_now_ns();
     long frames = 0;
     int rc = 0;
     while (!stop) {
@@ -126,7 +127,7 @@ static int run(int argc, char **argv)
             break;
         }
         frames += r;
-        double el = (double)(pb_usb_now_ns() - t0) * 1e-9;
+        double el = (double)(pb_now_ns() - t0) * 1e-9;
         if ((seconds > 0 && el >= seconds) || (count > 0 && frames >= count))
             break;
     }

@@ -28,6 +28,7 @@
 #include "usb_source.h"
 #include "usbmon.h"
 #include "pb_warn.h"
+#include "clock.h"
 
 static const char *data_path(char *buf, size_t n, const char *rel)
 {
@@ -225,18 +226,18 @@ static void test_timing_and_seek(void **state)
     pb_usb_replay_options o = {.speed = 1.0};
     assert_int_equal(pb_usb_replay_open(data_path(p, sizeof p, "usb/gonio_sit_to_stand.usbmon"), box(), &o, &src, &err),
                      POSE_OK);
-    int64_t start = pb_usb_now_ns(), t0 = -1, t = 0;
+    int64_t start = pb_now_ns(), t0 = -1, t = 0;
     pb_update u;
     while (t - t0 < 200000000 || t0 < 0) {
         if (pb_source_read(src, &u, 100) != 1)
             continue;
         if (t0 < 0) {
             t0 = u.t_ns;
-            start = pb_usb_now_ns();
+            start = pb_now_ns();
         }
         t = u.t_ns;
     }
-    double wall = (double)(pb_usb_now_ns() - start) * 1e-9;
+    double wall = (double)(pb_now_ns() - start) * 1e-9;
     print_message("0.2 s of capture replayed in %.4f s\n", wall);
     assert_true(wall > 0.19 && wall < 0.3);
     assert_int_equal(pb_source_seek(src, 6000000000LL), 0);
@@ -355,7 +356,7 @@ static int fake_read(pb_usb_transport *t, uint8_t *buf, size_t cap, int timeout_
     deg[12] = f->reads; /* knee_l */
     pb_gonio_pack(t->layout, deg, 0, (uint16_t)(f->reads > 5 ? f->reads - 6 : f->reads), NULL, fr);
     memcpy(buf, fr, sizeof fr);
-    *c = (pb_usb_completion){PB_USB_XFER_OK, sizeof fr, pb_usb_now_ns()};
+    *c = (pb_usb_completion){PB_USB_XFER_OK, sizeof fr, pb_now_ns()};
     return 1;
 }
 
@@ -433,10 +434,10 @@ static void test_hotplug_reopen(void **state)
     memset(&st, 0, sizeof st);
     src->on_status = log_state;
     src->on_status_user = &st;
-    int64_t t0 = pb_usb_now_ns();
+    int64_t t0 = pb_now_ns();
     for (int i = 0; i < 5; i++)
         assert_int_equal(pb_source_read(src, &u, 1000), 1);
-    double took = (double)(pb_usb_now_ns() - t0) * 1e-9;
+    double took = (double)(pb_now_ns() - t0) * 1e-9;
     print_message("%sretried for %.3f s\n", st.log, took);
     assert_int_equal(h.opens, 4); /* the first, the refused one on arrival, one refused retry, the one that works */
     assert_true(took >= 0.038 && took < 0.5); /* two retries 20 ms apart */
@@ -494,9 +495,9 @@ static void on_unplug(pb_source *src, pb_source_state st, const char *msg, void 
     unplug_watch *w = user;
     (void)src;
     if (st == PB_SOURCE_DISCONNECTED && !w->gone_at)
-        w->gone_at = pb_usb_now_ns();
+        w->gone_at = pb_now_ns();
     if (st == PB_SOURCE_WAITING && w->gone_at && !w->back_at) {
-        w->back_at = pb_usb_now_ns();
+        w->back_at = pb_now_ns();
         snprintf(w->back_msg, sizeof w->back_msg, "%s", msg);
     }
 }

@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 #include "hid_hidraw.h"
+#include "clock.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -157,7 +158,7 @@ static int hidraw_read(pb_hid_transport *t, uint8_t *buf, size_t cap, int timeou
 {
     hidraw *h = (hidraw *)t;
     int n = hid_read_timeout(h->dev, buf, cap, timeout_ms);
-    *t_ns = pb_hid_now_ns();
+    *t_ns = pb_now_ns();
     return n < 0 ? PB_HID_READ_GONE : n;
 }
 

@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 #include "hid_replay.h"
+#include "clock.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -26,7 +27,7 @@ static const pb_hid_rec_event *event_at(const replay *r, size_t i)
 static pose_status replay_open(pb_hid_transport *t, uint8_t *desc, size_t cap, size_t *len, pb_error *err)
 {
     replay *r = (replay *)t;
-    int64_t now = pb_hid_now_ns();
+    int64_t now = pb_now_ns();
     if (now < r->gone_until)
         return pb_fail(err, POSE_ERR_NOT_FOUND, "%s: device not present (simulated unplug)", t->origin);
     const pb_hid_rec_device *d = &r->rec->devices[r->opt.device];
@@ -75,7 +76,7 @@ static int inject(replay *r, const pb_hid_fault *f, uint8_t *buf, size_t cap, in
 static int replay_read(pb_hid_transport *t, uint8_t *buf, size_t cap, int timeout_ms, int64_t *t_ns)
 {
     replay *r = (replay *)t;
-    int64_t now = pb_hid_now_ns();
+    int64_t now = pb_now_ns();
     int64_t deadline = timeout_ms < 0 ? INT64_MAX : now + (int64_t)timeout_ms * 1000000;
     if (!r->started) {
         r->started = 1;
@@ -84,7 +85,7 @@ static int replay_read(pb_hid_transport *t, uint8_t *buf, size_t cap, int timeou
     }
     if (now < r->silent_until) {
         pb_hid_sleep_until(r->silent_until < deadline ? r->silent_until : deadline);
-        if (pb_hid_now_ns() < r->silent_until)
+        if (pb_now_ns() < r->silent_until)
             return 0;
     }
     if (r->pos >= r->count) {
@@ -101,14 +102,14 @@ static int replay_read(pb_hid_transport *t, uint8_t *buf, size_t cap, int timeou
             continue;
         r->fired[i] = 1;
         if (f->kind == PB_HID_FAULT_DISCONNECT) {
-            r->gone_until = pb_hid_now_ns() + (int64_t)f->duration_ms * 1000000;
+            r->gone_until = pb_now_ns() + (int64_t)f->duration_ms * 1000000;
             return PB_HID_READ_GONE;
         }
         if (f->kind == PB_HID_FAULT_SILENCE) {
             int64_t d = (int64_t)f->duration_ms * 1000000;
-            r->silent_until = pb_hid_now_ns() + d;
+            r->silent_until = pb_now_ns() + d;
             r->base_wall += d; /* everything after the silence comes that much later */
-            return replay_read(t, buf, cap, timeout_ms < 0 ? -1 : (int)((deadline - pb_hid_now_ns()) / 1000000), t_ns);
+            return replay_read(t, buf, cap, timeout_ms < 0 ? -1 : (int)((deadline - pb_now_ns()) / 1000000), t_ns);
         }
         return inject(r, f, buf, cap, t_ns);
     }
@@ -142,7 +143,7 @@ static int replay_seek(pb_hid_transport *t, int64_t t_ns)
     r->pos = lo;
     r->loop_offset = 0;
     r->started = 1;
-    r->base_wall = pb_hid_now_ns();
+    r->base_wall = pb_now_ns();
     r->base_t = lo < r->count ? event_at(r, lo)->t_ns : t_ns;
     return 0;
 }
@@ -207,7 +208,7 @@ pose_status pb_hid_replay_create(pb_hid_recording *rec, const char *origin, cons
         if (rec->events[i].device == r->opt.device)
             r->events[r->count++] = (uint32_t)i;
     if (r->opt.absent_ms > 0)
-        r->gone_until = pb_hid_now_ns() + (int64_t)r->opt.absent_ms * 1000000;
+        r->gone_until = pb_now_ns() + (int64_t)r->opt.absent_ms * 1000000;
     return pb_hid_source_create(&r->base, &r->opt.source, out, err);
 }
 

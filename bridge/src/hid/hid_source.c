@@ -9,6 +9,7 @@
 
 #include "hid_report.h"
 #include "pb_warn.h"
+#include "clock.h"
 
 typedef struct hid_source {
     pb_source base; /* first: a pb_source * is a hid_source * */
@@ -35,13 +36,6 @@ typedef struct hid_source {
     FILE *record;
     int64_t record_t0;
 } hid_source;
-
-int64_t pb_hid_now_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
 
 void pb_hid_sleep_until(int64_t t_ns)
 {
@@ -157,7 +151,7 @@ pose_status pb_hid_source_create(pb_hid_transport *t, const pb_hid_source_option
         snprintf(s->base.message, sizeof s->base.message, "%.200s", absent.message);
     else
         snprintf(s->base.message, sizeof s->base.message, "%s: open, no report yet", t->origin);
-    s->last_rx_ns = s->next_reopen_ns = pb_hid_now_ns();
+    s->last_rx_ns = s->next_reopen_ns = pb_now_ns();
     *out = &s->base;
     return POSE_OK;
 }
@@ -215,10 +209,10 @@ static int hid_read(pb_source *src, pb_update *out, int timeout_ms)
     hid_source *s = (hid_source *)src;
     if (s->base.state == PB_SOURCE_ENDED)
         return -1;
-    int64_t start = pb_hid_now_ns();
+    int64_t start = pb_now_ns();
     int64_t deadline = timeout_ms < 0 ? INT64_MAX : start + (int64_t)timeout_ms * 1000000;
     for (;;) {
-        int64_t now = pb_hid_now_ns();
+        int64_t now = pb_now_ns();
         if (!s->open) {
             if (now >= s->next_reopen_ns) {
                 if (reopen(s) == 0) {
@@ -243,7 +237,7 @@ static int hid_read(pb_source *src, pb_update *out, int timeout_ms)
         int wait_ms = wake == INT64_MAX ? -1 : wake <= now ? 0 : (int)((wake - now + 999999) / 1000000);
         int64_t t_ns = 0;
         int n = s->t->ops->read(s->t, s->report, sizeof s->report, wait_ms, &t_ns);
-        now = pb_hid_now_ns();
+        now = pb_now_ns();
         if (n == PB_HID_READ_ENDED) {
             pb_source_set_state(&s->base, PB_SOURCE_ENDED, "%s: end of recording", s->t->origin);
             return -1;
@@ -301,7 +295,7 @@ static int hid_seek(pb_source *src, int64_t t_ns)
         return -1;
     if (s->base.state == PB_SOURCE_ENDED)
         pb_source_set_state(&s->base, PB_SOURCE_WAITING, "%s: seeked", s->t->origin);
-    s->last_rx_ns = pb_hid_now_ns();
+    s->last_rx_ns = pb_now_ns();
     return 0;
 }
 

@@ -122,8 +122,6 @@ int pb_hid_source_record(pb_source *src, FILE *f);
 /** True when src is a HID source (live or replay). */
 int pb_source_is_hid(const pb_source *src);
 
-/** CLOCK_MONOTONIC in nanoseconds. */
-int64_t pb_hid_now_ns(void);
 /** Sleep until CLOCK_MONOTONIC reaches t_ns. */
 void pb_hid_sleep_until(int64_t t_ns);
 

@@ -15,6 +15,7 @@
  * (hid_source.c) decodes, keeps the states and reopens as for hidraw. */
 #define _GNU_SOURCE /* dlmopen */
 #include "usb_hid.h"
+#include "clock.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -160,7 +161,7 @@ static int hidusb_read(pb_hid_transport *t, uint8_t *buf, size_t cap, int timeou
     if (h->left)
         return PB_HID_READ_GONE;
     int n = h->api.read_timeout(h->dev, buf, cap, timeout_ms);
-    *t_ns = pb_hid_now_ns();
+    *t_ns = pb_now_ns();
     return n < 0 ? PB_HID_READ_GONE : n;
 }
 

@@ -10,6 +10,7 @@
  * coming back, so a reopen waits for the arrival instead of polling. A
  * stalled endpoint is cleared (libusb_clear_halt) before the next transfer. */
 #include "usb_source.h"
+#include "clock.h"
 
 #if POSE_BRIDGE_HAVE_LIBUSB
 
@@ -62,7 +63,7 @@ static void LIBUSB_CALL on_transfer(struct libusb_transfer *x)
         if (l->head - l->tail < RING) {
             slot *s = &l->ring[l->head++ % RING];
             s->c.status = st;
-            s->c.t_ns = pb_usb_now_ns();
+            s->c.t_ns = pb_now_ns();
             s->c.len = st == PB_USB_XFER_OK ? (size_t)x->actual_length : 0;
             if (s->c.len > sizeof s->data)
                 s->c.len = sizeof s->data;
@@ -228,7 +229,7 @@ static pose_status live_open(pb_usb_transport *t, pb_error *err)
 static int live_read(pb_usb_transport *t, uint8_t *buf, size_t cap, int timeout_ms, pb_usb_completion *c)
 {
     live *l = (live *)t;
-    int64_t deadline = timeout_ms < 0 ? INT64_MAX : pb_usb_now_ns() + (int64_t)timeout_ms * 1000000;
+    int64_t deadline = timeout_ms < 0 ? INT64_MAX : pb_now_ns() + (int64_t)timeout_ms * 1000000;
     for (;;) {
         if (l->tail != l->head) {
             slot *s = &l->ring[l->tail++ % RING];
@@ -250,12 +251,12 @@ static int live_read(pb_usb_transport *t, uint8_t *buf, size_t cap, int timeout_
         if (l->active == 0 && !l->need_clear_halt)
             return PB_USB_READ_GONE; /* every transfer ended: no device */
         /* handle events at least once, even when polled with timeout 0, then wait in slices of 100 ms */
-        int64_t now = pb_usb_now_ns();
+        int64_t now = pb_now_ns();
         int64_t wait = deadline == INT64_MAX ? 100000000 : deadline - now;
         wait = wait < 0 ? 0 : wait > 100000000 ? 100000000 : wait;
         struct timeval tv = {(time_t)(wait / 1000000000), (long)(wait % 1000000000 / 1000)};
         libusb_handle_events_timeout_completed(l->ctx, &tv, NULL);
-        if (l->tail == l->head && !l->left && !l->need_clear_halt && pb_usb_now_ns() >= deadline)
+        if (l->tail == l->head && !l->left && !l->need_clear_halt && pb_now_ns() >= deadline)
             return 0;
     }
 }
@@ -263,9 +264,9 @@ static int live_read(pb_usb_transport *t, uint8_t *buf, size_t cap, int timeout_
 static int live_wait_arrival(pb_usb_transport *t, int timeout_ms)
 {
     live *l = (live *)t;
-    int64_t deadline = pb_usb_now_ns() + (int64_t)timeout_ms * 1000000;
+    int64_t deadline = pb_now_ns() + (int64_t)timeout_ms * 1000000;
     for (;;) {
-        int64_t left = deadline - pb_usb_now_ns();
+        int64_t left = deadline - pb_now_ns();
         left = left < 0 ? 0 : left;
         struct timeval tv = {(time_t)(left / 1000000000), (long)(left % 1000000000 / 1000)};
         libusb_handle_events_timeout_completed(l->ctx, &tv, NULL); /* once at least, even for timeout 0 */
@@ -273,7 +274,7 @@ static int live_wait_arrival(pb_usb_transport *t, int timeout_ms)
             l->arrived = 0;
             return 1;
         }
-        if (pb_usb_now_ns() >= deadline)
+        if (pb_now_ns() >= deadline)
             return 0;
     }
 }

@@ -13,6 +13,7 @@
 #include "timeline.h"
 #include "usb_source.h"
 #include "usbmon.h"
+#include "clock.h"
 
 typedef struct replay {
     pb_usb_transport base;
@@ -59,7 +60,7 @@ static pose_status replay_open(pb_usb_transport *t, pb_error *err)
     replay *r = (replay *)t;
     size_t back = next_completion(r);
     /* Unplugged in the capture: absent until its next transfer (as fast as possible: at once). */
-    if (r->gone && !r->opt.as_fast_as_possible && back < r->count && pb_usb_now_ns() < due_at(r, back))
+    if (r->gone && !r->opt.as_fast_as_possible && back < r->count && pb_now_ns() < due_at(r, back))
         return pb_fail(err, POSE_ERR_NOT_FOUND, "%s: device not present (unplugged in the capture)", t->origin);
     r->gone = 0;
     return POSE_OK;
@@ -72,18 +73,18 @@ static int replay_wait_arrival(pb_usb_transport *t, int timeout_ms)
     size_t back = next_completion(r);
     if (!r->gone || back >= r->count)
         return 1;
-    int64_t until = pb_usb_now_ns() + (int64_t)timeout_ms * 1000000, due = due_at(r, back);
+    int64_t until = pb_now_ns() + (int64_t)timeout_ms * 1000000, due = due_at(r, back);
     int64_t wake = due < until ? due : until;
     struct timespec ts = {(time_t)(wake / 1000000000), (long)(wake % 1000000000)};
-    while (pb_usb_now_ns() < wake && clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) != 0) {
+    while (pb_now_ns() < wake && clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) != 0) {
     }
-    return pb_usb_now_ns() >= due;
+    return pb_now_ns() >= due;
 }
 
 static int replay_read(pb_usb_transport *t, uint8_t *buf, size_t cap, int timeout_ms, pb_usb_completion *c)
 {
     replay *r = (replay *)t;
-    int64_t now = pb_usb_now_ns();
+    int64_t now = pb_now_ns();
     int64_t deadline = timeout_ms < 0 ? INT64_MAX : now + (int64_t)timeout_ms * 1000000;
     if (!r->started) {
         r->started = 1;
@@ -113,7 +114,7 @@ static int replay_read(pb_usb_transport *t, uint8_t *buf, size_t cap, int timeou
                 return 0;
             }
             struct timespec ts = {(time_t)(due / 1000000000), (long)(due % 1000000000)};
-            while (pb_usb_now_ns() < due && clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) != 0) {
+            while (pb_now_ns() < due && clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL) != 0) {
             }
         }
         r->pos++;
@@ -165,7 +166,7 @@ static int replay_seek(pb_usb_transport *t, int64_t t_ns)
     r->gone = 0;
     r->loop_offset = 0;
     r->started = 1;
-    r->base_wall = pb_usb_now_ns();
+    r->base_wall = pb_now_ns();
     r->base_t = lo < r->count ? ev_t(r, lo) : t_ns;
     return 0;
 }

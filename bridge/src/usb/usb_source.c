@@ -9,6 +9,7 @@
 #include <time.h>
 
 #include "usbmon.h"
+#include "clock.h"
 
 typedef struct usb_source {
     pb_source base; /* first */
@@ -31,13 +32,6 @@ typedef struct usb_source {
     int64_t record_t0;
     uint64_t record_tag;
 } usb_source;
-
-int64_t pb_usb_now_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
 
 static int usb_read(pb_source *src, pb_update *out, int timeout_ms);
 static int usb_seek(pb_source *src, int64_t t_ns);
@@ -118,7 +112,7 @@ pose_status pb_usb_source_create(pb_usb_transport *t, const pb_usb_layout *layou
         free(s);
         return st;
     }
-    s->last_rx_ns = s->next_reopen_ns = pb_usb_now_ns();
+    s->last_rx_ns = s->next_reopen_ns = pb_now_ns();
     *out = &s->base;
     return POSE_OK;
 }
@@ -188,10 +182,10 @@ static int usb_read(pb_source *src, pb_update *out, int timeout_ms)
     usb_source *s = (usb_source *)src;
     if (s->base.state == PB_SOURCE_ENDED)
         return -1;
-    int64_t start = pb_usb_now_ns();
+    int64_t start = pb_now_ns();
     int64_t deadline = timeout_ms < 0 ? INT64_MAX : start + (int64_t)timeout_ms * 1000000;
     for (;;) {
-        int64_t now = pb_usb_now_ns();
+        int64_t now = pb_now_ns();
         if (!s->open) {
             /* With hotplug, wait for the arrival; an open that fails right after it (udev still setting
              * permissions, the device still starting) is retried every reopen_ms until it works. */
@@ -200,7 +194,7 @@ static int usb_read(pb_source *src, pb_update *out, int timeout_ms)
                 int64_t until = poll && s->next_reopen_ns < deadline ? s->next_reopen_ns : deadline;
                 int64_t w = until == INT64_MAX ? 1000 : (until - now) / 1000000;
                 arrived = s->t->ops->wait_arrival(s->t, (int)(w > 1000 ? 1000 : w < 0 ? 0 : w));
-                now = pb_usb_now_ns();
+                now = pb_now_ns();
             }
             if (arrived || (poll && now >= s->next_reopen_ns)) {
                 pb_error e;
@@ -231,7 +225,7 @@ static int usb_read(pb_source *src, pb_update *out, int timeout_ms)
         int wait_ms = wake == INT64_MAX ? -1 : wake <= now ? 0 : (int)((wake - now + 999999) / 1000000);
         pb_usb_completion c = {PB_USB_XFER_OK, 0, 0};
         int r = s->t->ops->read(s->t, s->frame, sizeof s->frame, wait_ms, &c);
-        now = pb_usb_now_ns();
+        now = pb_now_ns();
         if (r == PB_USB_READ_ENDED) {
             pb_source_set_state(&s->base, PB_SOURCE_ENDED, "%s: end of capture", s->t->origin);
             return -1;
@@ -289,7 +283,7 @@ static int usb_seek(pb_source *src, int64_t t_ns)
     pb_usb_decoder_resync(&s->dec);
     if (s->base.state == PB_SOURCE_ENDED)
         pb_source_set_state(&s->base, PB_SOURCE_WAITING, "%s: seeked", s->t->origin);
-    s->last_rx_ns = pb_usb_now_ns();
+    s->last_rx_ns = pb_now_ns();
     return 0;
 }
 

@@ -126,7 +126,5 @@ pose_status pb_usb_parse_spec(const char *spec, pb_usb_layout *l, pb_error *err)
 pose_status pb_usb_live_open(const char *spec, const pb_usb_layout *layout, const pb_usb_source_options *opt,
                              pb_source **out, pb_error *err);
 
-/** CLOCK_MONOTONIC ns. */
-int64_t pb_usb_now_ns(void);
 
 #endif /* POSE_BRIDGE_USB_SOURCE_H */
