@@ -365,7 +365,11 @@ int main(int argc, char **argv)
         lanes[i].lag_us = malloc(lanes[i].lag_cap * sizeof *lanes[i].lag_us);
         if (!lanes[i].lag_us)
             die("out of memory");
-        memset(lanes[i].lag_us, 0, lanes[i].lag_cap * sizeof *lanes[i].lag_us);
+        /* A non-zero fill: malloc + memset(0) becomes calloc, which leaves
+         * the pages untouched until the samples arrive and the resident set
+         * then grows by the bench's own buffer. */
+        for (size_t k = 0; k < lanes[i].lag_cap; k++)
+            lanes[i].lag_us[k] = -1.0;
     }
     phase_result steady, unplugged;
     run_phase(lanes, seconds, warmup, 0, &steady);

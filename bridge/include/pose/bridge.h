@@ -166,7 +166,7 @@ typedef struct pose_bridge_status {
     double last_sample_age_s;       /**< since the last good sample; -1 before the first */
     double media_s;                 /**< source time of the newest pose */
     double duration_s;              /**< recorded sources: length; live: -1 */
-    double lag_p50_ms, lag_p99_ms;  /**< bridge thread wake-up lateness (clips) */
+    double lag_p50_ms, lag_p99_ms;  /**< bridge thread wake-up lateness (clips), over every tick so far, within 1 % */
     double lag_max_ms;
     int realtime;                   /**< the bridge thread got the rt_priority it asked for */
     long frame;                     /**< clips: frame of the newest pose; -1 otherwise */

@@ -354,35 +354,6 @@ pose_status pose_bridge_pose_at(pose_bridge *b, double t_s, pose_state *st, pose
 
 /* ----------------------------------------------------------------- status */
 
-static int cmp_i64(const void *x, const void *y)
-{
-    int64_t a = *(const int64_t *)x, b = *(const int64_t *)y;
-    return (a > b) - (a < b);
-}
-
-/* Lag percentiles from the runner's record of wake-ups (the first 65536).
- * Sorted again only when the record grew by an eighth (or is small), so a
- * host may ask for the status every frame. */
-static void lag_percentiles(pose_bridge *b, uint64_t ticks, pose_bridge_status *o)
-{
-    size_t n = ticks < 65536 ? (size_t)ticks : 65536;
-    if (n != b->lag_ticks && (n < 4096 || n >= b->lag_ticks + b->lag_ticks / 8)) {
-        int64_t *lags = pb_bridge_alloc(b, n * sizeof *lags);
-        if (lags) {
-            size_t got = pb_runner_lags(b->runner, lags, n);
-            if (got) {
-                qsort(lags, got, sizeof *lags, cmp_i64);
-                b->lag_p50_ms = (double)lags[got / 2] * 1e-6;
-                b->lag_p99_ms = (double)lags[(got * 99) / 100] * 1e-6;
-            }
-            b->lag_ticks = got;
-            pb_bridge_free(b, lags);
-        }
-    }
-    o->lag_p50_ms = b->lag_p50_ms;
-    o->lag_p99_ms = b->lag_p99_ms;
-}
-
 pose_status pose_bridge_status_get(pose_bridge *b, pose_bridge_status *status)
 {
     if (!b || !status)
@@ -423,8 +394,13 @@ pose_status pose_bridge_status_get(pose_bridge *b, pose_bridge_status *status)
         o.lag_max_ms = s.lag_max_ms;
         o.realtime = s.realtime;
         snprintf(o.fault, sizeof o.fault, "%s", s.fault);
-        if (b->clip)
-            lag_percentiles(b, s.ticks, &o);
+        if (b->clip) {
+            static const double q[2] = {0.5, 0.99};
+            double ms[2];
+            pb_runner_lag_quantiles(b->runner, q, ms, 2);
+            o.lag_p50_ms = ms[0];
+            o.lag_p99_ms = ms[1];
+        }
     } else {
         o.state = (pose_bridge_source_state)b->scrub.state;
         o.samples = b->scrub.samples;

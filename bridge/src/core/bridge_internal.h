@@ -62,8 +62,6 @@ struct pose_bridge {
     pb_scrub scrub;
     pose_bridge_frame manual; /**< the last pose_bridge_pose_at */
     char fault[256];       /**< MANUAL: the scrubber's last fault */
-    uint64_t lag_ticks;    /**< ticks the cached lag percentiles were computed over */
-    double lag_p50_ms, lag_p99_ms;
     pb_warnings warnings;
 };
 

@@ -53,6 +53,7 @@ void pb_pose_copy(pb_pose *dst, const pb_pose *src)
     memcpy(dst->root_q, src->root_q, sizeof dst->root_q);
     dst->has_root = src->has_root;
     dst->t_ns = src->t_ns;
+    dst->lag_ns = src->lag_ns;
     dst->media_s = src->media_s;
     dst->frame = src->frame;
     dst->seq = src->seq;

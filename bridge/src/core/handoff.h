@@ -21,6 +21,7 @@ typedef struct pb_pose {
     float root_q[4];     /**< root rotation for pose_set_root ({0,0,0,1} when the root joint carries it) */
     int has_root;        /**< root_t/root_q are meaningful */
     int64_t t_ns;        /**< when the bridge produced it (CLOCK_MONOTONIC) */
+    int64_t lag_ns;      /**< how late: t_ns minus the recorded timing's deadline (0 for live sources) */
     double media_s;      /**< clip or source time it shows */
     long frame;          /**< clip frame (floor of media time), -1 for live sources */
     uint64_t seq;        /**< increases by one per published pose */

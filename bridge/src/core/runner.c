@@ -7,11 +7,11 @@
 #include <string.h>
 
 #include "clock.h"
+#include "lag_hist.h"
 #include "pb_math.h"
 #include "pb_thread.h"
 #include "pb_warn.h"
 
-enum { LAG_CAPACITY = 1 << 16 };
 
 struct pb_runner {
     pb_thread thread;
@@ -37,16 +37,16 @@ struct pb_runner {
     pb_clock clock;
     double period;
     double (*lq)[4], (*lt)[3];
-    int64_t *lags;
-    size_t lag_count;
+    pb_lag_hist lags; /* every tick's lag, constant memory */
     pb_error err;
     pose_status status;
     atomic_int source_state; /* stats.source, for readers that must not lock */
     pb_warnings *warnings;   /* the starting thread's sink, the bridge thread's from then on */
 };
 
-static void note_tick(pb_runner *r, const pb_pose *p, int64_t lag_ns)
+static void note_tick(pb_runner *r, const pb_pose *p)
 {
+    const int64_t lag_ns = p->lag_ns;
     /* caller holds mu */
     r->stats.ticks++;
     if (r->clip) {
@@ -64,8 +64,7 @@ static void note_tick(pb_runner *r, const pb_pose *p, int64_t lag_ns)
         r->fps_t0 = p->t_ns;
         r->fps_ticks0 = r->stats.ticks;
     }
-    if (r->lags && r->lag_count < LAG_CAPACITY)
-        r->lags[r->lag_count++] = lag_ns;
+    pb_lag_hist_add(&r->lags, lag_ns);
 }
 
 static void finish(pb_runner *r, pb_source_state st)
@@ -78,7 +77,7 @@ static void finish(pb_runner *r, pb_source_state st)
 }
 
 /* Publish the back slot, record it; returns nonzero on a recording error. */
-static int publish(pb_runner *r, pb_pose *back, int64_t lag_ns)
+static int publish(pb_runner *r, pb_pose *back)
 {
     pb_handoff_publish(&r->h);
     int bad = 0;
@@ -87,7 +86,7 @@ static int publish(pb_runner *r, pb_pose *back, int64_t lag_ns)
         bad = 1;
     }
     pb_mutex_lock(&r->mu);
-    note_tick(r, back, lag_ns);
+    note_tick(r, back);
     if (bad)
         snprintf(r->stats.fault, sizeof r->stats.fault, "%.255s", r->err.message);
     pb_mutex_unlock(&r->mu);
@@ -172,9 +171,10 @@ static void *clip_thread(void *arg)
         pb_pose *back = pb_handoff_back(&r->h);
         pb_retarget_apply(r->rt, (const double (*)[4])r->lq, (const double (*)[3])r->lt, r->period, back);
         back->t_ns = woke;
+        back->lag_ns = stepping ? 0 : woke - deadline;
         back->media_s = next;
         back->frame = (long)floor(t / r->clip->frame_time + 1e-9);
-        if (publish(r, back, stepping ? 0 : woke - deadline))
+        if (publish(r, back))
             break;
         next += r->period;
         if (past_end || (r->opt.max_ticks > 0 && r->stats.ticks >= (uint64_t)r->opt.max_ticks) ||
@@ -283,9 +283,10 @@ static void *source_thread(void *arg)
         pb_pose *back = pb_handoff_back(&r->h);
         pb_chanmap_pose(r->cm, back);
         back->t_ns = pb_now_ns();
+        back->lag_ns = 0;
         back->media_s = media;
         back->frame = -1;
-        if (publish(r, back, 0))
+        if (publish(r, back))
             break;
         if (r->opt.max_ticks > 0 && r->stats.ticks >= (uint64_t)r->opt.max_ticks) {
             finish(r, PB_SOURCE_ENDED);
@@ -308,7 +309,6 @@ static void runner_free(pb_runner *r)
     pb_handoff_free(&r->h);
     free(r->lq);
     free(r->lt);
-    free(r->lags);
     pb_mutex_destroy(&r->mu);
     pb_cond_destroy(&r->cv);
     free(r);
@@ -334,8 +334,8 @@ static pose_status runner_new(const pb_rig_skel *rig, const pb_runner_options *o
     atomic_init(&r->source_state, (int)PB_SOURCE_WAITING);
     r->stats.running = 1;
     r->stats.frame = -1;
-    r->lags = malloc(LAG_CAPACITY * sizeof *r->lags);
-    if (!r->lags || pb_handoff_init(&r->h, rig->joint_count) != 0) {
+    pb_lag_hist_reset(&r->lags);
+    if (pb_handoff_init(&r->h, rig->joint_count) != 0) {
         runner_free(r);
         return pb_fail(err, POSE_ERR_OUT_OF_MEMORY, "out of memory");
     }
@@ -485,13 +485,14 @@ int pb_runner_wait(pb_runner *r, int timeout_ms)
     return ended;
 }
 
-size_t pb_runner_lags(pb_runner *r, int64_t *out, size_t capacity)
+uint64_t pb_runner_lag_quantiles(pb_runner *r, const double *q, double *out_ms, int n)
 {
     pb_mutex_lock(&r->mu);
-    size_t n = r->lag_count < capacity ? r->lag_count : capacity;
-    memcpy(out, r->lags, n * sizeof *out);
+    for (int i = 0; i < n; i++)
+        out_ms[i] = pb_lag_hist_quantile_ns(&r->lags, q[i]) * 1e-6;
+    uint64_t count = r->lags.count;
     pb_mutex_unlock(&r->mu);
-    return n;
+    return count;
 }
 
 pose_status pb_runner_stop(pb_runner *r, pb_error *err)

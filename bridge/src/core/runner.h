@@ -97,9 +97,10 @@ int pb_runner_wait(pb_runner *r, int timeout_ms);
 /** Stop the thread, close the recording; NULL is a no-op. err may be NULL. */
 pose_status pb_runner_stop(pb_runner *r, pb_error *err);
 /**
- * Wake-up lateness (ns) of the first ticks (up to 65536), for benchmarks and
- * tests; copies at most `capacity`, returns the number copied.
+ * Wake-up lateness of every tick so far at the quantiles q[0..n) (0.5 the
+ * median, 1 the worst) in milliseconds, within 0.8 % (lag_hist.h); returns
+ * the number of ticks counted.
  */
-size_t pb_runner_lags(pb_runner *r, int64_t *out, size_t capacity);
+uint64_t pb_runner_lag_quantiles(pb_runner *r, const double *q, double *out_ms, int n);
 
 #endif /* POSE_BRIDGE_RUNNER_H */
