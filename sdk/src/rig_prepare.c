@@ -7,6 +7,7 @@
 #include "alloc.h"
 #include "error.h"
 #include "rig_internal.h"
+#include "rig_outside.h"
 #include "rig_runtime.h"
 
 static size_t align64(size_t n)
@@ -316,11 +317,14 @@ pose_status pose__rig_prepare(pose_rig *rig)
         memcpy(rt->rest_model[j].t, rig->joint_rest_model[j].translation, sizeof(float) * 3);
     }
     rig->rt = rt;
-    return prepare_fem(rig);
+    pose_status s = prepare_fem(rig);
+    return s == POSE_OK ? pose__rig_prepare_outside(rig) : s;
 }
 
 void pose__rig_release(pose_rig *rig)
 {
+    if (rig->rt)
+        pose__rig_release_outside(rig);
     if (rig->rt && rig->rt->fem_block)
         pose__free(&rig->allocator, rig->rt->fem_block);
     if (rig->rt)

@@ -7,6 +7,7 @@
 #include <stddef.h>
 
 #include "fem_mesh.h"
+#include "rt_bind.h"
 #include "rt_quat.h"
 #include "rt_skin.h"
 #include "rt_transfer.h"
@@ -31,6 +32,13 @@ struct pose__rig_runtime {
      *  tets, in its own allocation (fem_block, NULL without one). */
     pose__fem_mesh fem;
     void *fem_block;
+    /** Tissue vertices outside the tet mesh (rig_outside.c), bound to the
+     *  mesh (rt_bind.h) and placed after the transfer: outside_index holds
+     *  their numbers among all tissue vertices, ascending. Two allocations
+     *  of their own (NULL when every vertex is inside). */
+    pose__bind_mesh outside;
+    uint32_t *outside_index;
+    void *outside_block;
 };
 
 #endif /* POSE_RIG_RUNTIME_H */

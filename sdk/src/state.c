@@ -5,6 +5,7 @@
 
 #include "alloc.h"
 #include "error.h"
+#include "rig_outside.h"
 #include "rt_fk.h"
 #include "rt_thread.h"
 #include "rt_transfer.h"
@@ -234,6 +235,7 @@ void pose__state_transfer_task(void *ctx, unsigned part, unsigned parts)
     size_t e = pose__part_begin(mesh->block_count, part + 1, parts);
     st->flagged_count[part] = pose__transfer(mesh, st->tet_positions, b, e, st->tissue_positions,
                                              st->tissue_normals, st->flagged + b * POSE__BLOCK);
+    pose__state_place_outside(st, b * POSE__BLOCK, e * POSE__BLOCK); /* rig_outside.c */
 }
 
 /* Normals of the vertices in flat or inverted tets, from their triangles:
