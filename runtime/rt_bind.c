@@ -63,20 +63,25 @@ void pose__bind_rotation(const float F[9], float R[9])
     if (!(det > 1e-30) || !isfinite(det)) {
         gram_schmidt(X, out);
     } else {
-        /* Newton iteration X <- (g X + X^-T / g) / 2 with Higham's
-         * determinant scaling g = |det X|^(-1/3): quadratic convergence,
-         * a handful of steps for the stretch skinning produces, and an
-         * orthogonal F (a rigid move) is a fixed point to rounding. */
+        /* Newton iteration X <- (g X + X^-T / g) / 2: quadratic convergence,
+         * and an orthogonal F (a rigid move) is a fixed point to rounding.
+         * Higham's scaling g = |det X|^(-1/3) on the first step only takes
+         * out the volume change skinning makes; after it the iterate is
+         * near orthogonal, where scaling gains nothing and costs a cube
+         * root a step. Stops at float precision (the frame is stored as
+         * float). */
+        double g = 1.0 / cbrt(det);
         for (int it = 0; it < 20; it++) {
-            double g = 1.0 / cbrt(det), change = 0.0;
+            double change = 0.0;
             for (int k = 0; k < 9; k++) {
                 double x = 0.5 * (g * X[k] + C[k] / (g * det));
                 change = fmax(change, fabs(x - X[k]));
                 X[k] = x;
             }
-            if (change < 1e-12)
+            if (change < 1e-8)
                 break;
             det = cofactor(X, C);
+            g = 1.0;
         }
         memcpy(out, X, sizeof out);
     }
@@ -177,11 +182,23 @@ void pose__bind_place(const pose__bind_mesh *mesh, const float *tet_positions,
                       const pose__xform *skin, size_t begin, size_t end, const uint32_t *index,
                       float *out)
 {
-    float frame[POSE__BIND_MAX_ANCHORS][POSE__BIND_FRAME];
+    /* Neighbouring vertices share most anchors, and vertices numbered close
+     * together lie close together: a small direct-mapped cache of posed
+     * frames saves most of the work (it changes no result, only whether a
+     * frame is computed again). */
+    enum { SLOTS = 64 };
+    float cache[SLOTS][POSE__BIND_FRAME], frame[POSE__BIND_MAX_ANCHORS][POSE__BIND_FRAME];
+    uint32_t key[SLOTS];
+    memset(key, 0xff, sizeof key);
     const float *R[POSE__BIND_MAX_ANCHORS];
     for (size_t v = begin; v < end; v++) {
         for (unsigned k = 0; k < mesh->anchors; k++) {
-            frame_of(mesh, tet_positions, skin, mesh->anchor[v * mesh->anchors + k].frame, frame[k]);
+            const uint32_t f = mesh->anchor[v * mesh->anchors + k].frame, slot = f % SLOTS;
+            if (key[slot] != f) {
+                frame_of(mesh, tet_positions, skin, f, cache[slot]);
+                key[slot] = f;
+            }
+            memcpy(frame[k], cache[slot], sizeof frame[k]); /* a later anchor may evict it */
             R[k] = frame[k];
         }
         blend_vertex(mesh, v, R, tet_positions, out + 3 * (size_t)index[v]);

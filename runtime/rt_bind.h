@@ -83,10 +83,11 @@ void pose__bind_blend(const pose__bind_mesh *mesh, const float *frames, const fl
                       size_t begin, size_t end, float *out);
 
 /**
- * Vertices [begin, end), each posing its own anchors' frames as it goes (no
- * frame array: for a few vertices spread over a mesh, such as tissue
- * vertices outside it, where frames are seldom shared and a state would
- * need room for them); vertex v is written at out + 3 * index[v].
+ * Vertices [begin, end), posing their anchors' frames as they go (no frame
+ * array: for a few vertices spread over a mesh, such as tissue vertices
+ * outside it, so a state needs no room for frames; a small cache on the
+ * stack reuses the frames neighbouring vertices share); vertex v is written
+ * at out + 3 * index[v].
  */
 void pose__bind_place(const pose__bind_mesh *mesh, const float *tet_positions,
                       const pose__xform *skin, size_t begin, size_t end, const uint32_t *index,

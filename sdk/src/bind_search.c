@@ -199,8 +199,7 @@ static double tet_distance(const pose_rig *rig, size_t t, const double p[3], dou
 }
 
 /* Insert (t, dist) into the sorted list h[0..*n) of at most k. */
-static void offer(pose__bind_hit *h, unsigned *n, unsigned k, uint32_t t, float dist, double gap,
-                  const double foot[3])
+static void offer(pose__bind_hit *h, unsigned *n, unsigned k, uint32_t t, float dist)
 {
     unsigned at = *n;
     while (at > 0 && (h[at - 1].distance > dist || (h[at - 1].distance == dist && h[at - 1].tet > t)))
@@ -209,30 +208,27 @@ static void offer(pose__bind_hit *h, unsigned *n, unsigned k, uint32_t t, float 
         return;
     unsigned last = *n < k ? *n : k - 1;
     memmove(h + at + 1, h + at, (last - at) * sizeof *h);
-    h[at] = (pose__bind_hit){t, dist, gap, {foot[0], foot[1], foot[2]}};
+    h[at] = (pose__bind_hit){.tet = t, .distance = dist};
     if (*n < k)
         (*n)++;
 }
 
-static void visit_cell(const pose_rig *rig, const grid *g, size_t c, const double p[3],
-                       pose__bind_hit *h, unsigned *n, unsigned k)
+static void visit_cell(const grid *g, size_t c, const double p[3], pose__bind_hit *h, unsigned *n,
+                       unsigned k)
 {
     for (uint32_t i = g->start[c]; i < g->start[c + 1]; i++) {
         const float *x = g->centroid + 3 * (size_t)i;
         double dx = x[0] - p[0], dy = x[1] - p[1], dz = x[2] - p[2];
         float dist = (float)sqrt(dx * dx + dy * dy + dz * dz);
-        if (*n == k && dist > h[k - 1].distance)
-            continue;
-        double foot[3], gap = tet_distance(rig, g->tets[i], p, foot);
-        if (gap >= 0.0) /* else no frame: flat */
-            offer(h, n, k, g->tets[i], dist, gap, foot);
+        if (*n < k || dist <= h[k - 1].distance)
+            offer(h, n, k, g->tets[i], dist);
     }
 }
 
 /* Rings of cells at Chebyshev distance R around (cx, cy, cz), clipped to the
  * grid: after ring R every centroid nearer than R cells has been seen. */
-static void search_point(const pose_rig *rig, const grid *g, const double p[3], unsigned k,
-                         pose__bind_hit *h, unsigned *n)
+static void search_point(const grid *g, const double p[3], unsigned k, pose__bind_hit *h,
+                         unsigned *n)
 {
     const int cx = cell_of(g, p[0], 0), cy = cell_of(g, p[1], 1), cz = cell_of(g, p[2], 2);
     const int rmax = g->n[0] + g->n[1] + g->n[2];
@@ -247,7 +243,7 @@ static void search_point(const pose_rig *rig, const grid *g, const double p[3], 
                 const int shell = z == cz - R || z == cz + R || y == cy - R || y == cy + R;
                 for (int x = cx - R; x <= cx + R; x += shell ? 1 : 2 * R) {
                     if (x >= 0 && x < g->n[0])
-                        visit_cell(rig, g, cell_index(g, x, y, z), p, h, n, k);
+                        visit_cell(g, cell_index(g, x, y, z), p, h, n, k);
                     if (R == 0)
                         break;
                 }
@@ -267,7 +263,17 @@ pose_status pose__bind_nearest_tets(const pose_rig *rig, const float *xyz, size_
     if (s == POSE_OK)
         for (size_t i = 0; i < count; i++) {
             const double p[3] = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
-            search_point(rig, &g, p, k, hits + (size_t)k * i, &found[i]);
+            pose__bind_hit *h = hits + (size_t)k * i;
+            search_point(&g, p, k, h, &found[i]);
+            /* the exact distance and foot of the k found only; tets of
+             * (near) zero volume have no frame and drop out */
+            unsigned kept = 0;
+            for (unsigned j = 0; j < found[i]; j++) {
+                h[kept] = h[j];
+                h[kept].gap = tet_distance(rig, h[j].tet, p, h[kept].foot);
+                kept += h[kept].gap >= 0.0;
+            }
+            found[i] = kept;
         }
     pose__free(a, g.start);
     pose__free(a, g.tets);

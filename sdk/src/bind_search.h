@@ -21,9 +21,9 @@ typedef struct pose__bind_hit {
 /**
  * For each of `count` points (xyz interleaved), the k tets of the rig
  * whose centroids are nearest at rest, nearest first (ties by tet index),
- * into hits + k * point; found[point] says how many (fewer than k only
- * when the mesh has fewer usable tets). Tets of (near) zero volume are
- * skipped: they have no frame. Exact: centroids are binned into a uniform
+ * into hits + k * point; found[point] says how many: fewer than k when the
+ * mesh has fewer tets, or when some of the k have (near) zero volume (no
+ * frame: dropped). Exact: centroids are binned into a uniform
  * grid and rings of cells are searched outward until the k-th distance is
  * inside the rings.
  * Temporary memory from `a`; POSE_ERR_OUT_OF_MEMORY if it fails.
