@@ -73,6 +73,12 @@ pose_status pose__rig_prepare_outside(pose_rig *rig)
     pose_status s = pose__bind_build(rig, xyz, count, OUTSIDE_ANCHORS, POSE__BIND_NODES,
                                      &rig->allocator, &rt->outside, &rt->outside_block);
     pose__free(&rig->allocator, xyz);
+    if (s == POSE_ERR_UNSUPPORTED) { /* only flat tets near them: the transfer keeps them */
+        pose__clear_error();
+        pose__free(&rig->allocator, rt->outside_index);
+        rt->outside_index = NULL;
+        return POSE_OK;
+    }
     return s;
 }
 

@@ -312,6 +312,35 @@ static void api_checks(void **unused)
     pose_rig_free(other);
 }
 
+/* A mesh of flat tets only gives no frame: the host's binding says so, and
+ * a rig whose tissue vertex lies outside such a mesh still loads (the
+ * transfer keeps moving it). */
+static void flat_mesh(void **unused)
+{
+    (void)unused;
+    const float pos[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+    const uint32_t tet[4] = {0, 1, 2, 3};
+    const uint16_t label = 0, wj[4] = {0, 0, 0, 0};
+    const float w[4] = {1, 1, 1, 1};
+    const float vtx[3] = {2.0f, 0.0f, 0.0f}, bary[4] = {-1.0f, 2.0f, 0.0f, 0.0f};
+    const uint32_t vtet = 0;
+    pose_joint_desc j = {.name = "root", .parent = -1, .rest_model = {{0, 0, 0, 1}, {0, 0, 0}}};
+    pose_tissue_desc t = {.name = "skin", .kind = POSE_TISSUE_SKIN, .joint = -1, .vertex_count = 1,
+                          .positions = vtx, .tet = &vtet, .bary = bary};
+    pose_rig_desc d = {.joint_count = 1, .joints = &j, .tet_vertex_count = 4, .tet_positions = pos,
+                       .tet_count = 1, .tets = tet, .tet_labels = &label, .influences = 1,
+                       .weight_joints = wj, .weights = w, .tissue_count = 1, .tissues = &t};
+    pose_rig *rig;
+    if (pose_rig_create(&d, NULL, &rig) != POSE_OK)
+        fail_msg("%s", pose_last_error());
+    pose_binding *b;
+    assert_int_equal(pose_binding_create(rig, vtx, 1, NULL, &b), POSE_ERR_UNSUPPORTED);
+    pose_binding_options o = {.size = sizeof o, .sources = POSE_BINDING_BONES};
+    assert_int_equal(pose_binding_create(rig, vtx, 1, &o, &b), POSE_OK); /* a joint will do */
+    pose_binding_free(b);
+    pose_rig_free(rig);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -319,6 +348,7 @@ int main(void)
         cmocka_unit_test(rigid_motion_is_exact),
         cmocka_unit_test(deterministic_and_rest),
         cmocka_unit_test(api_checks),
+        cmocka_unit_test(flat_mesh),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
