@@ -139,10 +139,10 @@ static pose_status gather(const pose_rig *rig, const float *xyz, size_t count, u
                                    : pose__fail(POSE_ERR_OUT_OF_MEMORY,
                                                 "binding: out of memory for %zu points", count);
         for (size_t i = 0; s == POSE_OK && i < count; i++) {
-            const pose__bind_hit *x = hits + (size_t)kk * i, *near = x;
+            const pose__bind_hit *x = hits + (size_t)kk * i, *closest = x;
             for (unsigned h = 0; h < nh[i]; h++) {
-                if (x[h].gap < near->gap)
-                    near = &x[h];
+                if (x[h].gap < closest->gap)
+                    closest = &x[h];
                 for (int c = 0; c < 4; c++) {
                     const uint32_t v = rig->tets[4 * (size_t)x[h].tet + (size_t)c];
                     const float *q = rig->tet_positions + 3 * (size_t)v;
@@ -156,8 +156,8 @@ static pose_status gather(const pose_rig *rig, const float *xyz, size_t count, u
                         insert(cand + k * i, &found[i], k, cd);
                 }
             }
-            memcpy(foot + 3 * i, near->foot, 3 * sizeof(double));
-            foot_tet[i] = nh[i] ? near->tet : UINT32_MAX;
+            memcpy(foot + 3 * i, closest->foot, 3 * sizeof(double));
+            foot_tet[i] = nh[i] ? closest->tet : UINT32_MAX;
         }
         pose__free(a, hits);
         pose__free(a, nh);
