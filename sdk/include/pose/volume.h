@@ -11,10 +11,10 @@
  * Output voxels inside no posed tet get the background values.
  *
  * Threads: a sampler owns a worker pool; pose_volume_sample splits the
- * output grid into slabs of z, one per thread, and every slab visits the
- * tets in index order (a voxel inside two posed tets, where the deformation
- * folds, takes the later tet), so the output is identical for any thread
- * count. pose_volume_sample allocates nothing: everything is allocated by
+ * output grid into slabs of z, one per thread, and a voxel inside two posed
+ * tets (where the deformation folds, or a centre on a shared face) takes
+ * the later tet in index order whatever the slab, so the output is
+ * identical for any thread count. pose_volume_sample allocates nothing: everything is allocated by
  * pose_volume_sampler_create. libc, libm and pthreads only, as libpose.
  */
 #ifndef POSE_VOLUME_H

@@ -1,0 +1,76 @@
+/* SPDX-License-Identifier: Apache-2.0
+ * The volume sampler shared by volume_sample.c (the API and the passes of
+ * one call) and volume_raster.c (one posed tet into one z-slab). */
+#ifndef POSE_VOLUME_INTERNAL_H
+#define POSE_VOLUME_INTERNAL_H
+
+#include <stdint.h>
+
+#include "alloc.h"
+#include "pose/volume.h"
+#include "rt_pool.h"
+
+/* Barycentric tolerance: voxel centres on a face shared by two tets (grid-
+ * aligned meshes) belong to both rather than to neither. */
+#define POSE__VOL_EPS 1e-4
+
+/* The output voxel centres a posed tet's bounding box holds, per axis
+ * [lo, hi] clipped to the grid; a box without any has k0 > k1 (INT32_MAX,
+ * INT32_MIN: outside every slab). Set per call before the slabs run. */
+typedef struct pose__vol_box {
+    int32_t i0, i1, j0, j1, k0, k1;
+} pose__vol_box;
+
+struct pose_volume_sampler {
+    const pose_rig *rig;
+    pose_allocator allocator;
+    pose_volume_desc rest;
+    pose_volume_grid out;
+    double out_inv[3][4];   /* model -> output index */
+    int orient;             /* sign of det(rest index <- model) * det(output index <- model) */
+    size_t vertex_count, tet_count;
+    const uint32_t *tets;
+    float *rest_index;      /* 3 * V: rest vertices in the rest image's index space */
+    float *posed_index;     /* 3 * V: posed vertices in the output index space (per call) */
+    uint8_t *tet_flags;     /* per tet: POSE__VOL_REST_* (set at creation) */
+    pose__vol_box *boxes;   /* per tet (per call) */
+    /* One bit per output voxel, set when a posed tet holds its centre (per
+     * call); each row starts a new word (cover_words per row), so a row
+     * belongs to one slab and one thread. Bits rather than bytes: the
+     * per-call clear and the fill pass move an eighth of the memory. */
+    uint64_t *covered;
+    size_t cover_words;
+    pose__pool *pool;
+    /* the call in flight */
+    const float *posed;
+    float *dst_intensity;
+    uint16_t *dst_labels;
+};
+
+/* What a tet's rest positions say, once per sampler: the sign of its
+ * volume in the rest image's index space (the posed one must match, or
+ * the tet is folded), and whether all four lie inside the image's cells
+ * (its preimages need no clamping). */
+#define POSE__VOL_REST_POSITIVE 1
+#define POSE__VOL_REST_NEGATIVE 2
+#define POSE__VOL_REST_INSIDE 4
+
+/** The POSE__VOL_REST_* flags of a tet with rest vertices r (rest index
+ *  space) in an image of grid g. */
+int pose__volume_rest_flags(const pose_volume_grid *g, const float *r[4]);
+
+/** Rasterize posed tet `t` (its box `box`) into output planes k0..k1 (one
+ *  slab's share of the box): its covered voxels get the rest image sampled
+ *  through the tet's inverse map and their covered bits. The values a voxel
+ *  gets depend on the tet and the voxel only, never on k0/k1, so any slab
+ *  split gives the same bytes. */
+void pose__volume_raster_tet(const pose_volume_sampler *s, size_t t, const pose__vol_box *box,
+                             int k0, int k1);
+
+/** The covered bits of output row (j, k). */
+static inline uint64_t *pose__vol_cover_row(const pose_volume_sampler *s, size_t j, size_t k)
+{
+    return s->covered + (k * s->out.ny + j) * s->cover_words;
+}
+
+#endif /* POSE_VOLUME_INTERNAL_H */
