@@ -219,11 +219,17 @@ static inline void tet_corners(const pose__fem_tet *t, const float R[9], const f
 
 /* Rotation, cofactor and J - 1 of one tet at x, stored in rot[20]. */
 static inline void tet_linearize(const pose__fem_tet *t, const float *x, float *q, float *rot,
-                                 float F[9], int steps)
+                                 float F[9], int steps, int linear_volume)
 {
     tet_gradient(t, x, F);
     extract_rotation(F, q, rot, steps);
     rot[18] = cofactor(F, rot + 9) - 1.0f;
+    if (linear_volume) {
+        /* C = R, J - 1 = tr(R^T F) - 3: plain co-rotated linear elasticity */
+        memcpy(rot + 9, rot, 9 * sizeof(float));
+        rot[18] = rot[0] * F[0] + rot[3] * F[3] + rot[6] * F[6] + rot[1] * F[1] + rot[4] * F[4] +
+                  rot[7] * F[7] + rot[2] * F[2] + rot[5] * F[5] + rot[8] * F[8] - 3.0f;
+    }
 }
 
 /* ------------------------------------------------------------ passes */
@@ -241,7 +247,8 @@ typedef struct solve_ctx {
     float vol_product; /**< kappa_g (gvol . p) */
 } solve_ctx;
 
-static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const float *x, size_t t0);
+static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const float *x, size_t t0,
+                         int linear_volume);
 
 /* The 3x3 diagonal blocks of K at the tet's corners (symmetric, 6 floats:
  * xx xy xz yy yz zz): moving corner k by d alone gives G = d g^T, whose
@@ -277,18 +284,18 @@ static void tet_blocks(const pose__fem_tet *t, const float *rot, float *out)
     }
 }
 
-static void tets_rotate(solve_ctx *c, size_t b, size_t e)
+void pose__fem_tets_rotate(const pose__fem_mesh *m, pose__fem_work *w, const float *x,
+                           int linear_volume, size_t b, size_t e)
 {
-    const pose__fem_tet *tets = c->mesh->tets;
-    pose__fem_work *w = c->w;
+    const pose__fem_tet *tets = m->tets;
     size_t t = b;
     for (; t + 8 <= e; t += 8)
-        rotate_block(tets, w, c->x, t);
+        rotate_block(tets, w, x, t, linear_volume);
     for (size_t u = b; u < t; u++)
         tet_blocks(&tets[u], w->rot + 20 * u, w->dblk + 24 * u);
     for (; t < e; t++) {
         float F[9], *rot = w->rot + 20 * t;
-        tet_linearize(&tets[t], c->x, w->quat + 4 * t, rot, F, FEM_POLAR_STEPS);
+        tet_linearize(&tets[t], x, w->quat + 4 * t, rot, F, FEM_POLAR_STEPS, linear_volume);
         tet_corners(&tets[t], rot, rot + 9, rot[18], F, 1, w->corner + 12 * t);
         tet_blocks(&tets[t], rot, w->dblk + 24 * t);
     }
@@ -425,7 +432,8 @@ static void rotation_block(const pose__v8f A[9], pose__v8f q[4], pose__v8f R[9])
     quat_to_mat_block(q, R);
 }
 
-static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const float *x, size_t t0)
+static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const float *x, size_t t0,
+                         int linear_volume)
 {
     pose__v8f B[9], vmu, vkappa;
     uint32_t idx[4][8];
@@ -451,6 +459,12 @@ static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const flo
     C[7] = F[2] * F[3] - F[0] * F[5];
     C[8] = F[0] * F[4] - F[1] * F[3];
     pose__v8f jm1 = (F[0] * C[0] + F[1] * C[1] + F[2] * C[2]) - V8_SPLAT(1.0f);
+    if (linear_volume) { /* as tet_linearize */
+        for (int k = 0; k < 9; k++)
+            C[k] = R[k];
+        jm1 = R[0] * F[0] + R[3] * F[3] + R[6] * F[6] + R[1] * F[1] + R[4] * F[4] + R[7] * F[7] +
+              R[2] * F[2] + R[5] * F[5] + R[8] * F[8] - V8_SPLAT(3.0f);
+    }
     float *rot = w->rot + 20 * t0;
     for (int l = 0; l < 8; l++) {
         for (int k = 0; k < 4; k++)
@@ -466,16 +480,16 @@ static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const flo
 }
 
 /* The product K p: the search direction p' = z + beta p formed per corner. */
-static void product_block(const pose__fem_tet *tets, pose__fem_work *w, float beta, size_t t0)
+static void product_block(const pose__fem_tet *tets, pose__fem_work *w, const float *z,
+                          const float *p, const pose__v8f *vb, size_t t0)
 {
     pose__v8f B[9], vmu, vkappa;
     uint32_t idx[4][8];
     load_block(tets, t0, B, &vmu, &vkappa, idx);
-    const pose__v8f vb = V8_SPLAT(beta);
     pose__v8f d[4][3];
     for (int k = 0; k < 4; k++)
         for (int a = 0; a < 3; a++)
-            d[k][a] = V8_GATHER(w->z, idx[k], 3, a) + vb * V8_GATHER(w->p, idx[k], 3, a);
+            d[k][a] = V8_GATHER(z, idx[k], 3, a) + *vb * V8_GATHER(p, idx[k], 3, a);
     pose__v8f G[9], R[9], C[9];
     gradient_block(B, d, G);
     const float *rot = w->rot + 20 * t0;
@@ -492,21 +506,27 @@ static void product_block(const pose__fem_tet *tets, pose__fem_work *w, float be
 
 /* The next search direction p' = z + beta p is formed per corner here and
  * stored per vertex by the gather that follows, saving a pass. */
-static void tets_product(solve_ctx *c, size_t b, size_t e)
+void pose__fem_tets_product(const pose__fem_mesh *m, pose__fem_work *w, const float *z,
+                            const float *p, const float *beta, const uint32_t *group, size_t b,
+                            size_t e)
 {
-    const pose__fem_tet *tets = c->mesh->tets;
-    pose__fem_work *w = c->w;
-    const float beta = c->beta;
+    const pose__fem_tet *tets = m->tets;
     size_t t = b;
-    for (; t + 8 <= e; t += 8)
-        product_block(tets, w, beta, t);
+    for (; t + 8 <= e; t += 8) {
+        pose__v8f vb = V8_SPLAT(beta[0]);
+        if (group)
+            for (int l = 0; l < 8; l++)
+                vb[l] = beta[group[t + (size_t)l]];
+        product_block(tets, w, z, p, &vb, t);
+    }
     for (; t < e; t++) {
         const pose__fem_tet *tt = &tets[t];
+        const float bt = beta[group ? group[t] : 0];
         float d[4][3];
         for (int k = 0; k < 4; k++) {
             size_t v = 3 * (size_t)tt->v[k];
             for (int a = 0; a < 3; a++)
-                d[k][a] = w->z[v + a] + beta * w->p[v + a];
+                d[k][a] = z[v + a] + bt * p[v + a];
         }
         float G[9];
         for (int r = 0; r < 3; r++)
@@ -519,18 +539,32 @@ static void tets_product(solve_ctx *c, size_t b, size_t e)
     }
 }
 
-static inline void gather(const pose__fem_mesh *m, const float *corner, size_t v, float out[3])
+void pose__fem_vertex_block(const pose__fem_mesh *m, const float *dblk, size_t v, double k[6])
 {
-    float s[3] = {0, 0, 0};
-    for (uint32_t k = m->corner_offset[v]; k < m->corner_offset[v + 1]; k++) {
-        const float *f = corner + 3 * (size_t)m->corners[k];
-        s[0] += f[0];
-        s[1] += f[1];
-        s[2] += f[2];
+    for (int e = 0; e < 6; e++)
+        k[e] = 0.0;
+    for (uint32_t i = m->corner_offset[v]; i < m->corner_offset[v + 1]; i++) {
+        const float *b = dblk + 6 * (size_t)m->corners[i];
+        for (int e = 0; e < 6; e++)
+            k[e] += b[e];
     }
-    out[0] = s[0];
-    out[1] = s[1];
-    out[2] = s[2];
+}
+
+int pose__fem_invert_block(const double k[6], float out[6])
+{
+    const double c00 = k[3] * k[5] - k[4] * k[4], c01 = k[2] * k[4] - k[1] * k[5],
+                 c02 = k[1] * k[4] - k[2] * k[3];
+    const double det = k[0] * c00 + k[1] * c01 + k[2] * c02;
+    if (!(det > 1e-30 * k[0] * k[3] * k[5]))
+        return -1;
+    const double s = 1.0 / det;
+    out[0] = (float)(c00 * s);
+    out[1] = (float)(c01 * s);
+    out[2] = (float)(c02 * s);
+    out[3] = (float)((k[0] * k[5] - k[2] * k[2]) * s);
+    out[4] = (float)((k[1] * k[2] - k[0] * k[4]) * s);
+    out[5] = (float)((k[0] * k[3] - k[1] * k[1]) * s);
+    return 0;
 }
 
 /* The inverse of vertex v's diagonal block (symmetric, 6 floats), or zero
@@ -538,35 +572,13 @@ static inline void gather(const pose__fem_mesh *m, const float *corner, size_t v
  * block is singular (a vertex of flat tets only). */
 static void vertex_preconditioner(const pose__fem_mesh *m, const float *dblk, size_t v, float *pre)
 {
-    double k[6] = {0, 0, 0, 0, 0, 0};
-    for (uint32_t i = m->corner_offset[v]; i < m->corner_offset[v + 1]; i++) {
-        const float *b = dblk + 6 * (size_t)m->corners[i];
-        for (int e = 0; e < 6; e++)
-            k[e] += b[e];
-    }
-    const double c00 = k[3] * k[5] - k[4] * k[4], c01 = k[2] * k[4] - k[1] * k[5],
-                 c02 = k[1] * k[4] - k[2] * k[3];
-    const double det = k[0] * c00 + k[1] * c01 + k[2] * c02;
+    double k[6];
+    pose__fem_vertex_block(m, dblk, v, k);
     const float id = m->inv_diag[v];
-    if (id == 0.0f || !(det > 1e-30 * k[0] * k[3] * k[5])) {
+    if (id == 0.0f || pose__fem_invert_block(k, pre) < 0) {
         pre[0] = pre[3] = pre[5] = id;
         pre[1] = pre[2] = pre[4] = 0.0f;
-        return;
     }
-    const double s = 1.0 / det;
-    pre[0] = (float)(c00 * s);
-    pre[1] = (float)(c01 * s);
-    pre[2] = (float)(c02 * s);
-    pre[3] = (float)((k[0] * k[5] - k[2] * k[2]) * s);
-    pre[4] = (float)((k[1] * k[2] - k[0] * k[4]) * s);
-    pre[5] = (float)((k[0] * k[3] - k[1] * k[1]) * s);
-}
-
-static inline void apply_pre(const float *pre, const float r[3], float z[3])
-{
-    z[0] = pre[0] * r[0] + pre[1] * r[1] + pre[2] * r[2];
-    z[1] = pre[1] * r[0] + pre[3] * r[1] + pre[4] * r[2];
-    z[2] = pre[2] * r[0] + pre[4] * r[1] + pre[5] * r[2];
 }
 
 static void vertices_pass(solve_ctx *c, size_t chunk)
@@ -583,7 +595,7 @@ static void vertices_pass(solve_ctx *c, size_t chunk)
         const float *gv = w->gvol + 3 * v;
         if (c->pass == PASS_GATHER_RESIDUAL) {
             float f[3];
-            gather(m, w->corner, v, f);
+            pose__fem_gather(m, w->corner, v, f);
             float *pre = w->pre + 6 * v;
             vertex_preconditioner(m, w->dblk, v, pre);
             for (int a = 0; a < 3; a++) {
@@ -591,14 +603,14 @@ static void vertices_pass(solve_ctx *c, size_t chunk)
                                  : 0.0f;
                 p[a] = 0.0f;
             }
-            apply_pre(pre, r, z);
+            pose__fem_apply_block(pre, r, z);
             for (int a = 0; a < 3; a++) {
                 s0 += (double)r[a] * z[a];
                 s1 += (double)r[a] * r[a];
             }
         } else if (c->pass == PASS_GATHER_PRODUCT) {
             float f[3];
-            gather(m, w->corner, v, f);
+            pose__fem_gather(m, w->corner, v, f);
             for (int a = 0; a < 3; a++) {
                 p[a] = z[a] + c->beta * p[a];
                 ap[a] = id > 0.0f ? f[a] : 0.0f;
@@ -615,7 +627,7 @@ static void vertices_pass(solve_ctx *c, size_t chunk)
                 float apv = id > 0.0f ? ap[a] + c->vol_product * gv[a] : 0.0f;
                 r[a] -= c->alpha * apv;
             }
-            apply_pre(w->pre + 6 * v, r, z);
+            pose__fem_apply_block(w->pre + 6 * v, r, z);
             for (int a = 0; a < 3; a++) {
                 s0 += (double)r[a] * z[a];
                 s1 += (double)r[a] * r[a];
@@ -639,9 +651,9 @@ static void pass_task(void *ctx, unsigned part, unsigned parts)
         if (e > m->tet_count)
             e = m->tet_count;
         if (c->pass == PASS_ROTATE)
-            tets_rotate(c, b, e);
+            pose__fem_tets_rotate(m, c->w, c->x, 0, b, e);
         else
-            tets_product(c, b, e);
+            pose__fem_tets_product(m, c->w, c->w->z, c->w->p, &c->beta, NULL, b, e);
         return;
     }
     size_t b = pose__part_begin(m->chunk_count, part, parts);
@@ -679,7 +691,7 @@ static void run(solve_ctx *c, pose__pool *pool, int pass, double *s0, double *s1
  * w->gvol (serial: a few thousand surface vertices, and the scatter to tet
  * vertices must sum in one order); returns the volume term's force factor
  * -kappa_g (V - V0). */
-static double volume_gradient(const pose__fem_mesh *m, pose__fem_work *w, const float *x)
+double pose__fem_volume_gradient(const pose__fem_mesh *m, pose__fem_work *w, const float *x)
 {
     const pose__fem_surface *s = &m->surface;
     memset(w->gvol, 0, 3 * m->vertex_count * sizeof(float));
@@ -733,7 +745,7 @@ void pose__fem_solve(const pose__fem_mesh *m, pose__fem_work *w, pose__pool *poo
     for (int outer = 0; outer < prm->outer_iterations && m->tet_count > 0; outer++) {
         double t0 = now();
         run(&c, pool, PASS_ROTATE, NULL, NULL, NULL);
-        c.vol_force = (float)volume_gradient(m, w, x);
+        c.vol_force = (float)pose__fem_volume_gradient(m, w, x);
         double rz = 0.0;
         run(&c, pool, PASS_GATHER_RESIDUAL, &rz, &rr, NULL);
         double t1 = now();
@@ -779,9 +791,9 @@ void pose__fem_forces(const pose__fem_mesh *m, pose__fem_work *w, const float *x
 {
     for (size_t t = 0; t < m->tet_count; t++) {
         float F[9], *rot = w->rot + 20 * t;
-        tet_linearize(&m->tets[t], x, w->quat + 4 * t, rot, F, 64);
+        tet_linearize(&m->tets[t], x, w->quat + 4 * t, rot, F, 64, 0);
         tet_corners(&m->tets[t], rot, rot + 9, rot[18], F, 1, w->corner + 12 * t);
     }
     for (size_t v = 0; v < m->vertex_count; v++)
-        gather(m, w->corner, v, forces + 3 * v);
+        pose__fem_gather(m, w->corner, v, forces + 3 * v);
 }

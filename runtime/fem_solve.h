@@ -13,6 +13,7 @@
 #define POSE_FEM_SOLVE_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "fem_mesh.h"
 #include "rt_pool.h"
@@ -58,6 +59,60 @@ void pose__fem_work_reset(const pose__fem_mesh *mesh, pose__fem_work *work);
  */
 void pose__fem_solve(const pose__fem_mesh *mesh, pose__fem_work *work, pose__pool *pool,
                      const pose__fem_params *params, float *x, pose__fem_stats *stats);
+
+/* ---- The passes the solvers share (fem_dynamics.c runs them too). Tet
+ * passes take tets [b, e) in whole blocks of 8 from b; each writes only its
+ * own tets' records, so parts of one pass may run at once. */
+
+/** Every tet's rotation, cofactor and J - 1 at x into work->rot, its
+ *  elastic corner forces into work->corner, its corners' 3x3 stiffness
+ *  blocks into work->dblk. linear_volume: the volume term of plain
+ *  co-rotated linear elasticity instead (the cofactor replaced by R and
+ *  J - 1 by tr(R^T F) - 3): force and warped stiffness R K0 R^T then agree
+ *  up to R's own derivative, which the dynamics need (the det F term's
+ *  curvature, left out of its Gauss-Newton stiffness, is of the size of
+ *  the volume stiffness itself once a tet inverts, and backward Euler
+ *  integrated it explicitly: the body's swing blew up). */
+void pose__fem_tets_rotate(const pose__fem_mesh *mesh, pose__fem_work *work, const float *x,
+                           int linear_volume, size_t b, size_t e);
+/** Corner products K d of the warped stiffness (the last rotate pass's)
+ *  with d = z + beta p per vertex, into work->corner. beta[group[t]] per tet,
+ *  or beta[0] for all when group is NULL. */
+void pose__fem_tets_product(const pose__fem_mesh *mesh, pose__fem_work *work, const float *z,
+                            const float *p, const float *beta, const uint32_t *group, size_t b,
+                            size_t e);
+/** The skin volume term's gradient at x into work->gvol (serial); returns
+ *  its force factor -stiffness (V - V0) (0 without a surface). */
+double pose__fem_volume_gradient(const pose__fem_mesh *mesh, pose__fem_work *work, const float *x);
+/** Vertex v's 3x3 stiffness block (xx xy xz yy yz zz), summed over its
+ *  corners' blocks in work->dblk in the fixed corner order. */
+void pose__fem_vertex_block(const pose__fem_mesh *mesh, const float *dblk, size_t v, double k[6]);
+/** Inverse of a symmetric 3x3 block; -1 (out untouched) when singular. */
+int pose__fem_invert_block(const double k[6], float out[6]);
+
+/** Sum of vertex v's corner values (3 each) in the fixed corner order. */
+static inline void pose__fem_gather(const pose__fem_mesh *m, const float *corner, size_t v,
+                                    float out[3])
+{
+    float s[3] = {0, 0, 0};
+    for (uint32_t k = m->corner_offset[v]; k < m->corner_offset[v + 1]; k++) {
+        const float *f = corner + 3 * (size_t)m->corners[k];
+        s[0] += f[0];
+        s[1] += f[1];
+        s[2] += f[2];
+    }
+    out[0] = s[0];
+    out[1] = s[1];
+    out[2] = s[2];
+}
+
+/** z = B r for a symmetric block B (6 floats). */
+static inline void pose__fem_apply_block(const float *pre, const float r[3], float z[3])
+{
+    z[0] = pre[0] * r[0] + pre[1] * r[1] + pre[2] * r[2];
+    z[1] = pre[1] * r[0] + pre[3] * r[1] + pre[4] * r[2];
+    z[2] = pre[2] * r[0] + pre[4] * r[1] + pre[5] * r[2];
+}
 
 /** Elastic forces on every vertex at x with every tet's rotation taken
  *  from x (polar decomposition; not masked by held vertices). For tests. */

@@ -13,7 +13,16 @@
  * pool's spinning included): on a machine shared with other work, where
  * wall times stretch, cpu / threads bounds what two idle cores take.
  *
- *   fem RIG [--threads N] [--reps N] [--tolerance T] [--outer N]
+ * Then dynamics (pose_step, default settings): --steps steps of
+ * dt = 1/120 s while both shoulders and elbows swing 0 -> 90 -> 0 degrees
+ * at 360 deg/s, then rest: steps per second (wall and per CPU second),
+ * the mean cost of each part (skinning, assembly, CG, transfer), CG
+ * iterations, and the bytes a step streams against the STREAM triad
+ * bandwidth measured in the same run with the same thread count
+ * (bound = triad / bytes per step; ratio = achieved / bound).
+ *
+ *   fem RIG [--threads N] [--reps N] [--tolerance T] [--outer N] [--steps N]
+ *           [--dynamics-only]
  */
 #include <math.h>
 #include <stdio.h>
@@ -23,6 +32,7 @@
 #include "bench_common.h"
 #include "fem_volume.h"
 #include "pose/pose.h"
+#include "state_internal.h"
 
 typedef struct posture {
     const char *name;
@@ -52,16 +62,108 @@ static int set_posture(const pose_rig *rig, pose_state *st, const posture *p, fl
     return 0;
 }
 
+/* Both shoulders and elbows at `deg` (flexion). */
+static int set_swing(const pose_rig *rig, pose_state *st, double deg)
+{
+    static const char *const joints[] = {"shoulder_r", "shoulder_l", "elbow_r", "elbow_l"};
+    const float a[3] = {(float)deg, 0.0f, 0.0f};
+    for (int k = 0; k < 4; k++) {
+        int j = pose_rig_find_joint(rig, joints[k]);
+        if (j < 0 || pose_set_joint_clinical(st, j, a) < 0) {
+            fprintf(stderr, "fem: %s: %s\n", joints[k], pose_last_error());
+            return -1;
+        }
+    }
+    return 0;
+}
+
+static int bench_dynamics(const pose_rig *rig, int threads, int steps)
+{
+    pose_state_options so = {.size = sizeof so, .threads = threads};
+    pose_state *st;
+    if (pose_state_create_ex(rig, &so, &st) || pose_set_method(st, POSE_FEM) ||
+        pose_set_dynamics_options(st, NULL)) {
+        fprintf(stderr, "fem: %s\n", pose_last_error());
+        return -1;
+    }
+    const double dt = 1.0 / 120.0, rate = 360.0, swing = 4.0 * 90.0 / rate;
+    /* start at rest in the swing's first pose (not the T-pose of the bake) */
+    if (set_swing(rig, st, 0.0) || pose_reset_dynamics(st)) {
+        fprintf(stderr, "fem: %s\n", pose_last_error());
+        return -1;
+    }
+    pose_dynamics_stats ds = {.size = sizeof ds}, sum = {0};
+    double wall = 0.0, cpu = 0.0, peak = 0.0;
+    int cg_max = 0;
+    for (int s = 1; s <= steps; s++) {
+        const double t = s * dt, u = fmod(fmin(t, swing) * rate, 180.0);
+        if (set_swing(rig, st, u <= 90.0 ? u : 180.0 - u))
+            return -1;
+        const double t0 = bench_now(), c0 = bench_cpu_seconds();
+        if (pose_step(st, dt) != POSE_OK) {
+            fprintf(stderr, "fem: %s\n", pose_last_error());
+            return -1;
+        }
+        wall += bench_now() - t0;
+        cpu += bench_cpu_seconds() - c0;
+        pose_get_dynamics_stats(st, &ds);
+        sum.seconds_skin += ds.seconds_skin;
+        sum.seconds_assembly += ds.seconds_assembly;
+        sum.seconds_cg += ds.seconds_cg;
+        sum.seconds_transfer += ds.seconds_transfer;
+        sum.cg_iterations += ds.cg_iterations;
+        cg_max = ds.cg_iterations > cg_max ? ds.cg_iterations : cg_max;
+        peak = fmax(peak, ds.kinetic_energy);
+    }
+    const double cg_mean = (double)sum.cg_iterations / steps;
+    const double bytes = pose__state_dynamics_bytes(st, cg_mean);
+    const double triad = bench_triad_bytes_per_s((unsigned)threads, (size_t)1 << 24, 5);
+    const double sps = steps / wall, bound = triad / bytes, ms = 1e3 / steps;
+    pose_tet_info tet;
+    pose_rig_tet_info(rig, &tet);
+    size_t soft = 0;
+    for (size_t t = 0; t < tet.tet_count; t++)
+        soft += tet.labels[t] == 0;
+    printf("dynamics: dt 1/120 s, %d steps (%.2f s swinging shoulders and elbows 0-90-0 at 360 "
+           "deg/s twice, then rest), %zu tets (%zu soft), %d island(s), %d threads\n",
+           steps, swing, tet.tet_count, soft, ds.islands, threads);
+    printf("  %.1f steps/s (target 120), %.2f ms/step wall, %.2f ms CPU/step (all threads)\n", sps,
+           wall * ms, cpu * ms);
+    printf("  per step: skin %.2f ms, assembly %.2f ms, CG %.2f ms (%.1f iterations, most %d, "
+           "%.3f ms each), transfer %.2f ms\n",
+           sum.seconds_skin * ms, sum.seconds_assembly * ms, sum.seconds_cg * ms, cg_mean, cg_max,
+           sum.cg_iterations ? 1e3 * sum.seconds_cg / sum.cg_iterations : 0.0,
+           sum.seconds_transfer * ms);
+    printf("  memory: %.2f MB/step, triad %.2f GB/s -> bound %.0f steps/s; achieved/bound %.3f\n",
+           bytes / 1e6, triad / 1e9, bound, sps / bound);
+    printf("  kinetic energy: peak %.3e J, %.3e J at the end (%.2f s simulated)\n", peak,
+           ds.kinetic_energy, ds.time);
+    pose_state_free(st);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2 || !strcmp(argv[1], "--help")) {
-        fprintf(stderr, "usage: fem RIG [--threads N] [--reps N] [--tolerance T] [--outer N]\n");
+        fprintf(stderr, "usage: fem RIG [--threads N] [--reps N] [--tolerance T] [--outer N] "
+                        "[--steps N] [--dynamics-only]\n");
         return argc < 2 ? 2 : 0;
     }
-    int threads = 2, reps = 5, outer = 0;
+    int threads = 2, reps = 5, outer = 0, steps = 480, statics = 1;
     float tol = 0.0f;
-    for (int i = 2; i + 1 < argc; i += 2) {
-        if (!strcmp(argv[i], "--threads"))
+    for (int i = 2; i < argc; i += 2) {
+        if (!strcmp(argv[i], "--dynamics-only")) {
+            statics = 0;
+            i--;
+            continue;
+        }
+        if (i + 1 >= argc) {
+            fprintf(stderr, "fem: %s needs a value\n", argv[i]);
+            return 2;
+        }
+        if (!strcmp(argv[i], "--steps"))
+            steps = atoi(argv[i + 1]);
+        else if (!strcmp(argv[i], "--threads"))
             threads = atoi(argv[i + 1]);
         else if (!strcmp(argv[i], "--reps"))
             reps = atoi(argv[i + 1]);
@@ -106,7 +208,7 @@ int main(int argc, char **argv)
            "outer", "CG", "skin", "rot", "cg", "xfer", "ms/CG", "ratio", "cpu ms");
     pose_state_options so = {.size = sizeof so, .threads = threads};
     double worst = 0.0, slowest = 0.0;
-    for (size_t p = 0; p < sizeof k_postures / sizeof k_postures[0]; p++) {
+    for (size_t p = 0; statics && p < sizeof k_postures / sizeof k_postures[0]; p++) {
         pose_state *sk, *fem;
         if (pose_state_create_ex(rig, &so, &sk) || pose_state_create_ex(rig, &so, &fem)) {
             fprintf(stderr, "fem: %s\n", pose_last_error());
@@ -158,8 +260,11 @@ int main(int argc, char **argv)
         pose_state_free(sk);
         pose_state_free(fem);
     }
-    printf("FEM: largest |dV| %.3f %% (target 0.3 %%), slowest posture (warm) %.2f ms (target 50 ms)"
-           "; process CPU %.1f s\n", 100 * worst, slowest, bench_cpu_seconds());
+    if (statics)
+        printf("FEM: largest |dV| %.3f %% (target 0.3 %%), slowest posture (warm) %.2f ms (target "
+               "50 ms); process CPU %.1f s\n", 100 * worst, slowest, bench_cpu_seconds());
+    if (steps > 0 && bench_dynamics(rig, threads, steps))
+        return 1;
     pose_rig_free(rig);
     return 0;
 }

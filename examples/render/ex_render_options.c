@@ -34,6 +34,9 @@ void ex_render_usage(FILE *f)
           "  --hide KINDS                 hide tissue kinds: skin,bone,muscle,organ,other\n"
           "  --weights JOINT              colour the tet mesh by this joint's skinning weight\n"
           "  --caption TEXT               caption drawn at the top of each image\n"
+          "  --slices                     beside the model: axial, coronal and sagittal slices of the\n"
+          "                               rig's scan (pose-bake --labels) posed alike, label colours\n"
+          "                               over the CT, through the middle of the grid\n"
           "  --azimuth DEG --elevation DEG --zoom F   camera (default: frames the whole model)\n"
           "  --focus JOINT                close-up: frame the region around this joint\n"
           "  --fit pose|rest|follow       frame every pose shown (default); or the rest pose only, so\n"
@@ -105,7 +108,7 @@ int ex_render_parse(int argc, char **argv, ex_render_options *o, char *err, size
     o->zoom = 1.0;
     enum { OPT_JSON = POSE_CLI_LONG_ONLY, OPT_LIST_JOINTS, OPT_COMPARE, OPT_SOURCE, OPT_MAP, OPT_CAPTION,
            OPT_WEIGHTS, OPT_FOCUS, OPT_POSE, OPT_FRAMES, OPT_TIMES, OPT_TURNTABLE, OPT_METHOD, OPT_SKIN, OPT_FIT,
-           OPT_HIDE, OPT_SIZE, OPT_SUPERSAMPLE, OPT_THREADS, OPT_AZIMUTH, OPT_ELEVATION, OPT_ZOOM };
+           OPT_HIDE, OPT_SIZE, OPT_SUPERSAMPLE, OPT_THREADS, OPT_AZIMUTH, OPT_ELEVATION, OPT_ZOOM, OPT_SLICES };
     static const struct option options[] = {
         {"output", required_argument, NULL, 'o'},           {"json", no_argument, NULL, OPT_JSON},
         {"list-joints", no_argument, NULL, OPT_LIST_JOINTS}, {"compare", no_argument, NULL, OPT_COMPARE},
@@ -119,6 +122,7 @@ int ex_render_parse(int argc, char **argv, ex_render_options *o, char *err, size
         {"supersample", required_argument, NULL, OPT_SUPERSAMPLE},
         {"threads", required_argument, NULL, OPT_THREADS},   {"azimuth", required_argument, NULL, OPT_AZIMUTH},
         {"elevation", required_argument, NULL, OPT_ELEVATION}, {"zoom", required_argument, NULL, OPT_ZOOM},
+        {"slices", no_argument, NULL, OPT_SLICES},
         {"help", no_argument, NULL, 'h'},                    {0}};
     pose_cli cli;
     pose_cli_begin(&cli, "pose-render", argc, argv, options);
@@ -137,6 +141,9 @@ int ex_render_parse(int argc, char **argv, ex_render_options *o, char *err, size
             break;
         case OPT_COMPARE:
             o->compare = 1;
+            break;
+        case OPT_SLICES:
+            o->slices = 1;
             break;
         case POSE_CLI_ARGUMENT:
             if (o->rig) {
@@ -256,6 +263,10 @@ int ex_render_parse(int argc, char **argv, ex_render_options *o, char *err, size
     if (modes > 1 && !(modes == 2 && o->compare && o->source && o->frame_count + o->time_count == 1)) {
         snprintf(err, err_size, "choose one of --source, --turntable, --compare (--compare takes --source with "
                                 "one frame or time)");
+        return -1;
+    }
+    if (o->slices && o->compare) {
+        snprintf(err, err_size, "--slices shows one pose: it does not combine with --compare");
         return -1;
     }
     if (o->frames && o->times) {

@@ -19,6 +19,7 @@ typedef struct ex_render_options {
     int width, height, supersample, turntable, compare, json, threads, list_joints;
     int fit_rest; /* frame the camera on the rest pose only (comparable images across calls) */
     int follow;   /* --frames: the camera follows the model (moving target, fixed distance) */
+    int slices;   /* the rig's scan posed alike, as three slices beside the model */
     int method; /* -1: CoR when the rig has it, else LBS */
     long *frames;
     size_t frame_count;

@@ -20,6 +20,12 @@
 #include "ex_motion.h"
 #include "ex_render_options.h"
 #include "ex_scene.h"
+#include "ex_volume_posed.h"
+#include "vol_slices.h"
+#include "vol_slices_image.h"
+
+/* --slices: pixels between the model and the slices. */
+#define SLICES_GAP 8
 
 typedef struct renderer {
     OSMesaContext ctx;
@@ -178,6 +184,7 @@ typedef struct job {
     renderer r;
     ex_image img;
     ex_camera cam;
+    ex_volume_posed vol; /* --slices */
     pose_method method;
     float bmin[3], bmax[3]; /* what the camera frames */
     float half[3];          /* largest half-extents of one frame, for --fit follow */
@@ -358,6 +365,33 @@ done:
     return rc;
 }
 
+/* The image to write: img itself, or with --slices img and the posed scan's
+ * slices through the middle of its grid beside it (top aligned, SLICES_GAP
+ * apart, as tall as img allows) in *both (free it). */
+static const ex_image *with_slices(job *jb, const ex_image *img, ex_image *both)
+{
+    if (!jb->o->slices)
+        return img;
+    ex_volume_posed *v = &jb->vol;
+    if (ex_volume_posed_update(v, jb->sc.state, jb->err, jb->err_size) < 0)
+        return NULL;
+    const int c[3] = {v->n[0] / 2, v->n[1] / 2, v->n[2] / 2};
+    ex_image sl = {0};
+    if (ex_volume_slices_image(&sl, v->hu, v->labels, v->n, v->spacing, c, EX_VOLUME_LEVEL,
+                               EX_VOLUME_WIDTH, ex_volume_slices_zoom(v->n, v->spacing, img->height),
+                               bg8) < 0 ||
+        ex_image_init(both, img->width + SLICES_GAP + sl.width, img->height > sl.height ? img->height : sl.height,
+                      bg8) < 0) {
+        ex_image_free(&sl);
+        snprintf(jb->err, jb->err_size, "out of memory for the slices");
+        return NULL;
+    }
+    ex_image_blit(both, img, 0, 0);
+    ex_image_blit(both, &sl, img->width + SLICES_GAP, 0);
+    ex_image_free(&sl);
+    return both;
+}
+
 /* One image per requested frame or recorded time of the source. */
 static int render_frames(job *jb)
 {
@@ -388,8 +422,13 @@ static int render_frames(job *jb)
         snprintf(text, sizeof text, "%s%s%s  %s", o->caption ? o->caption : "", o->caption ? "  " : "", what,
                  ex_method_name(jb->method));
         caption(&jb->img, text);
-        if (emit(jb->s, &jb->img, path, o->times ? -1 : o->frames[i], o->times ? o->times[i] : -1.0,
-                 ex_method_name(jb->method), 1e3 * (ex_now() - t0), jb->sc.last_apply_ms, jb->err, jb->err_size) < 0)
+        ex_image both = {0};
+        const ex_image *out = with_slices(jb, &jb->img, &both);
+        int bad = !out || emit(jb->s, out, path, o->times ? -1 : o->frames[i], o->times ? o->times[i] : -1.0,
+                               ex_method_name(jb->method), 1e3 * (ex_now() - t0), jb->sc.last_apply_ms,
+                               jb->err, jb->err_size) < 0;
+        ex_image_free(&both);
+        if (bad)
             return -1;
     }
     return 0;
@@ -409,8 +448,12 @@ static int render_turntable(job *jb, int n, int folder)
             snprintf(path, sizeof path, "%s/turn_%03d.png", jb->out, i);
         else
             snprintf(path, sizeof path, "%s", jb->out);
-        if (emit(jb->s, &jb->img, path, -1, -1.0, ex_method_name(jb->method), 1e3 * (ex_now() - t0), jb->sc.last_apply_ms,
-                 jb->err, jb->err_size) < 0)
+        ex_image both = {0};
+        const ex_image *out = with_slices(jb, &jb->img, &both);
+        int bad = !out || emit(jb->s, out, path, -1, -1.0, ex_method_name(jb->method), 1e3 * (ex_now() - t0),
+                               jb->sc.last_apply_ms, jb->err, jb->err_size) < 0;
+        ex_image_free(&both);
+        if (bad)
             return -1;
     }
     return 0;
@@ -427,7 +470,8 @@ static int run(const ex_render_options *o, summary *s, char *err, size_t err_siz
         ex_scene_close(&jb.sc);
         return 0;
     }
-    if (prepare(&jb) < 0 || frame_camera(&jb) < 0)
+    if (prepare(&jb) < 0 || frame_camera(&jb) < 0 ||
+        (o->slices && ex_volume_posed_open(&jb.vol, jb.sc.rig, o->threads, err, err_size) < 0))
         goto done;
     /* The pose to show, after framing tried the others. */
     if (!o->compare && !jb.motion &&
@@ -454,6 +498,7 @@ static int run(const ex_render_options *o, summary *s, char *err, size_t err_siz
 done:
     s->clamped = jb.sc.clamped;
     ex_image_free(&jb.img);
+    ex_volume_posed_close(&jb.vol);
     renderer_free(&jb.r);
     ex_motion_close(jb.motion);
     ex_scene_close(&jb.sc);

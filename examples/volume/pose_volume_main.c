@@ -23,6 +23,7 @@
 #include "pose_cli.h"
 #include "vol_nifti.h"
 #include "vol_slices.h"
+#include "vol_slices_image.h"
 
 #define MAX_POSES 64
 
@@ -231,11 +232,12 @@ int main(int argc, char **argv)
         }
         char path[1024];
         snprintf(path, sizeof path, "%s_rest.png", png);
-        int bad = ex_volume_slices_png(path, hu0, lab0, (int)g.nx, (int)g.ny, (int)g.nz, ct.spacing, c[0],
-                                       c[1], c[2], 40.0f, 500.0f, err, sizeof err);
+        const int dims[3] = {(int)g.nx, (int)g.ny, (int)g.nz};
+        int bad = ex_volume_slices_png(path, hu0, lab0, dims, ct.spacing, c, EX_VOLUME_LEVEL,
+                                       EX_VOLUME_WIDTH, err, sizeof err);
         snprintf(path, sizeof path, "%s_posed.png", png);
-        bad = bad || ex_volume_slices_png(path, hu, lab, (int)g.nx, (int)g.ny, (int)g.nz, ct.spacing, c[0],
-                                          c[1], c[2], 40.0f, 500.0f, err, sizeof err);
+        bad = bad || ex_volume_slices_png(path, hu, lab, dims, ct.spacing, c, EX_VOLUME_LEVEL,
+                                          EX_VOLUME_WIDTH, err, sizeof err);
         if (bad) {
             fprintf(stderr, "pose-volume: %s\n", err);
             status = 1;

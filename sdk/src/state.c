@@ -153,6 +153,7 @@ pose_status pose_state_create_ex(const pose_rig *rig, const pose_state_options *
     if (fem)
         pose__fem_work_init(&rig->rt->fem, block + off_fem, &st->fem_work);
     pose__state_fem_defaults(&st->fem_params);
+    pose_dynamics_defaults(&st->dyn_options);
     for (size_t j = 0; j < nj; j++)
         pose__quat_identity(st->local[j]);
     pose__state_rig_ranges(st);
@@ -174,6 +175,8 @@ void pose_state_free(pose_state *st)
     if (!st)
         return;
     pose_allocator alloc = st->allocator;
+    if (st->dyn_block)
+        pose__free(&alloc, st->dyn_block);
     if (st->pool) {
         pose__pool_destroy(st->pool);
         pose__free(&alloc, st->pool);
@@ -249,44 +252,58 @@ void pose__state_fix_normals_task(void *ctx, unsigned part, unsigned parts)
                                st->flagged_count[part], st->tissue_normals);
 }
 
+/* Small meshes run on the caller alone: waking workers would cost more
+ * than the work (results are the same either way). */
+static bool serial_frame(const pose_state *st)
+{
+    return st->rt->skin.block_count + st->rt->transfer.block_count < POSE__SERIAL_BLOCKS;
+}
+
+void pose__state_skin_pass(pose_state *st)
+{
+    const pose_rig *rig = st->rig;
+    pose__fk(rig->joint_count, rig->joint_parents, st->rt->rest_model,
+             (const float(*)[4])st->local, &st->root, st->skin, st->world);
+    pose__skin_palette(rig->joint_count, st->skin, st->palette);
+    if (serial_frame(st))
+        pose__state_skin_task(st, 0, 1);
+    else
+        pose__pool_run(st->pool, pose__state_skin_task, st);
+}
+
+void pose__state_transfer_pass(pose_state *st)
+{
+    if (serial_frame(st)) {
+        pose__state_transfer_task(st, 0, 1);
+        if (st->flagged_count[0] > 0)
+            pose__state_fix_normals_task(st, 0, 1);
+        return;
+    }
+    pose__pool_run(st->pool, pose__state_transfer_task, st);
+    size_t flagged = 0;
+    for (unsigned p = 0; p < pose__pool_threads(st->pool); p++)
+        flagged += st->flagged_count[p];
+    if (flagged > 0)
+        pose__pool_run(st->pool, pose__state_fix_normals_task, st);
+}
+
 pose_status pose_apply(pose_state *st)
 {
     pose__clear_error();
     if (!st)
         return pose__fail(POSE_ERR_INVALID_ARGUMENT, "pose_apply: state is NULL");
-    const pose_rig *rig = st->rig;
-    pose__fk(rig->joint_count, rig->joint_parents, st->rt->rest_model,
-             (const float(*)[4])st->local, &st->root, st->skin, st->world);
-    pose__skin_palette(rig->joint_count, st->skin, st->palette);
-    /* Small meshes run on the caller alone: waking workers would cost more
-     * than the work (results are the same either way). */
-    const size_t blocks = st->rt->skin.block_count + st->rt->transfer.block_count;
-    const bool serial = blocks < POSE__SERIAL_BLOCKS;
     double t0 = st->method == POSE_FEM ? pose__seconds() : 0.0;
-    if (serial)
-        pose__state_skin_task(st, 0, 1);
-    else
-        pose__pool_run(st->pool, pose__state_skin_task, st);
+    pose__state_skin_pass(st);
     if (st->method == POSE_FEM) {
         double t1 = pose__seconds();
         st->fem_stats.seconds_skin = t1 - t0;
         pose__state_fem_refine(st); /* state_fem.c */
         t0 = pose__seconds();
     }
-    if (serial) {
-        pose__state_transfer_task(st, 0, 1);
-        if (st->flagged_count[0] > 0)
-            pose__state_fix_normals_task(st, 0, 1);
-    } else {
-        pose__pool_run(st->pool, pose__state_transfer_task, st);
-        size_t flagged = 0;
-        for (unsigned p = 0; p < pose__pool_threads(st->pool); p++)
-            flagged += st->flagged_count[p];
-        if (flagged > 0)
-            pose__pool_run(st->pool, pose__state_fix_normals_task, st);
-    }
+    pose__state_transfer_pass(st);
     if (st->method == POSE_FEM)
         st->fem_stats.seconds_transfer = pose__seconds() - t0;
+    pose__state_contact(st); /* contact.c: skin out of bone, on the final positions */
     return POSE_OK;
 }
 

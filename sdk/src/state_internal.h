@@ -9,6 +9,7 @@
 #include <stdint.h>
 
 #include "clinical_math.h"
+#include "fem_dynamics.h"
 #include "fem_solve.h"
 #include "pose/pose.h"
 #include "rig_internal.h"
@@ -44,6 +45,11 @@ struct pose_state {
     pose__fem_work fem_work;
     pose__fem_params fem_params;
     pose_fem_stats fem_stats;
+    /* Dynamics (state_dynamics.c): own allocation, made when first enabled */
+    pose__fem_dyn dyn;
+    void *dyn_block;            /**< NULL until pose_step or pose_set_dynamics_options */
+    pose_dynamics_options dyn_options;
+    pose_dynamics_stats dyn_stats;
 
     pose__pool *pool;           /**< own allocation: replaced by pose_set_threads */
     void *block;                /**< the allocation holding everything else */
@@ -61,6 +67,11 @@ struct pose_state {
  *  array the kernels stream, read or written once (benchmarks). */
 size_t pose__state_frame_bytes(const pose_state *st);
 
+/** Bytes a pose_step streams with `cg_iterations` CG iterations: the
+ *  skinning and transfer of a frame, the solver's passes and the copy of
+ *  the positions (benchmarks). */
+double pose__state_dynamics_bytes(const pose_state *st, double cg_iterations);
+
 /** The skinning kernel a method runs (POSE_FEM skins with CoR, else DQS). */
 int pose__state_skin_method(const pose_state *st);
 /** pose_apply's passes (ctx: the state; part of parts). */
@@ -71,6 +82,10 @@ void pose__state_fix_normals_task(void *ctx, unsigned part, unsigned parts);
 double pose__seconds(void);
 /** Default FEM solver settings. */
 void pose__state_fem_defaults(pose__fem_params *out);
+/** FK, skinning palette and skinning of the tet mesh into tet_positions. */
+void pose__state_skin_pass(pose_state *st);
+/** Transfer of tet_positions to the tissues (positions, normals). */
+void pose__state_transfer_pass(pose_state *st);
 /** pose_apply's FEM refinement of st->tet_positions (after skinning). */
 void pose__state_fem_refine(pose_state *st);
 

@@ -637,6 +637,83 @@ POSE_API pose_status pose_set_fem_options(pose_state *state, const pose_fem_opti
 /** Statistics of the last FEM refinement (zeros before one); out->size must be set. @since 0.2 */
 POSE_API pose_status pose_get_fem_stats(const pose_state *state, pose_fem_stats *out);
 
+/**
+ * Dynamics (design §2, Otaduy et al. §5.1-5.2): pose_step advances the
+ * soft tissue by dt toward the skeleton as the setters left it, by backward
+ * Euler with linearized forces: A v' = b, x' = x + dt v', with
+ * A = (1 + dt alpha) M + (dt beta + dt^2) K (M - dt dF/dv - dt^2 dF/dx
+ * with Rayleigh damping alpha M + beta K), K the co-rotational (warped)
+ * stiffness of the rig's soft tets at the current positions and the bone
+ * springs', b = M v + dt f, f the elastic forces (POSE_FEM's material and
+ * skin volume term, with the tets' volume term of plain co-rotated linear
+ * elasticity: its warped stiffness is exact up to the rotation's own
+ * derivative, which keeps large steps stable where tets invert), gravity
+ * and the bones' pull. Bones are kinematic rigid bodies at the skinned pose (the
+ * method's skinning, CoR or DQS for POSE_FEM): every bone node (a vertex of
+ * a bone tet that also belongs to a soft tet) is tied to its bone by a
+ * zero-length spring, every other bone vertex moves with its bone. Each
+ * coupling island (a connected part of the soft tissue) is solved by its
+ * own block-Jacobi preconditioned conjugate gradients, warm-started from
+ * the last velocities. Then the tet mesh (pose_tet_positions) and every
+ * tissue (the usual transfer) show the simulated positions.
+ *
+ * The simulation starts at rest in the skinned pose of its first step or of
+ * pose_reset_dynamics. Its buffers are allocated, with the state's
+ * allocator, by the first pose_step or pose_set_dynamics_options; later
+ * steps allocate nothing. Results are identical for any thread count.
+ * pose_apply writes the outputs from skinning (or POSE_FEM) and leaves the
+ * simulation as it is; the last of the two calls is what the outputs show.
+ * Stable from dt = 1/1000 s to 1/30 s, also under fast joint swings.
+ */
+
+/** Dynamics settings. Start from pose_dynamics_defaults; every field is
+ *  taken as set. */
+typedef struct pose_dynamics_options {
+    size_t size;              /**< sizeof(pose_dynamics_options) */
+    float mass_damping;       /**< Rayleigh alpha, 1/s, >= 0 (default 1) */
+    float stiffness_damping;  /**< Rayleigh beta, s, >= 0 (default 0.01) */
+    float gravity[3];         /**< rig units / s^2 (default 0) */
+    float coupling_stiffness; /**< the bone springs' stiffness as a multiple of each bone
+                                   node's own elastic stiffness, > 0 (default 100) */
+    float tolerance;          /**< CG stops for an island when the velocity error, measured
+                                   by its energy (preconditioned residual), is this
+                                   fraction of the step's momentum b, or of the island
+                                   moving at 1e-2 rig units/s where b is smaller (at
+                                   rest b is rounding noise); in (0, 1) (default 1e-2) */
+    int cg_iterations;        /**< most CG iterations per island and step, >= 1 (default 50) */
+} pose_dynamics_options;
+
+/** What the last pose_step did. */
+typedef struct pose_dynamics_stats {
+    size_t size;              /**< sizeof(pose_dynamics_stats), set by the caller */
+    int islands;              /**< coupling islands (connected parts of the soft tissue) */
+    int cg_iterations;        /**< most over the islands */
+    double residual;          /**< largest final error as a fraction of b (see tolerance) */
+    double kinetic_energy;    /**< of the simulated vertices after the step, J (rig units: m) */
+    double time;              /**< simulated seconds since the simulation started */
+    double seconds_skin;      /**< FK and skinning (where the bones go) */
+    double seconds_assembly;  /**< rotations, forces, right-hand side, preconditioner, update */
+    double seconds_cg;        /**< conjugate gradient iterations */
+    double seconds_transfer;  /**< transfer to the tissues */
+} pose_dynamics_stats;
+
+/** The default dynamics settings (size set). @since 0.2 */
+POSE_API void pose_dynamics_defaults(pose_dynamics_options *out);
+/** Set the dynamics settings (NULL: defaults); allocates the simulation if
+ *  it has none yet. POSE_ERR_INVALID_ARGUMENT for a field out of range,
+ *  POSE_ERR_UNSUPPORTED for a rig without a fem section or with massless
+ *  soft tissue (density 0). @since 0.2 */
+POSE_API pose_status pose_set_dynamics_options(pose_state *state,
+                                               const pose_dynamics_options *options);
+/** Advance the simulation by dt seconds (0 < dt <= 1) toward the posed
+ *  skeleton and write the outputs. Errors as pose_set_dynamics_options. @since 0.2 */
+POSE_API pose_status pose_step(pose_state *state, double dt);
+/** Restart the simulation at rest in the current skinned pose and write
+ *  the outputs. Errors as pose_set_dynamics_options. @since 0.2 */
+POSE_API pose_status pose_reset_dynamics(pose_state *state);
+/** Statistics of the last pose_step (zeros before one); out->size must be set. @since 0.2 */
+POSE_API pose_status pose_get_dynamics_stats(const pose_state *state, pose_dynamics_stats *out);
+
 /* ---------------------------------------------------------------- bounds */
 
 /**

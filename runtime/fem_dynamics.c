@@ -1,0 +1,539 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* Backward Euler dynamics of the co-rotational FEM (fem_dynamics.h). */
+#include "fem_dynamics.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "rt_thread.h"
+
+static size_t align64(size_t n)
+{
+    return (n + 63u) & ~(size_t)63u;
+}
+
+/* ------------------------------------------------------------ topology */
+
+static int is_dynamic(const pose__fem_mesh *m, size_t v)
+{
+    return m->corner_offset[v + 1] > m->corner_offset[v] && m->mass[v] > 0.0f;
+}
+
+/* Union-find with the smaller index as root: a set's root is its first
+ * vertex, so numbering roots in vertex order numbers islands in order. */
+static uint32_t find(uint32_t *p, uint32_t a)
+{
+    while (p[a] != a) {
+        p[a] = p[p[a]];
+        a = p[a];
+    }
+    return a;
+}
+
+static void unite(uint32_t *p, uint32_t a, uint32_t b)
+{
+    a = find(p, a);
+    b = find(p, b);
+    if (a < b)
+        p[b] = a;
+    else if (b < a)
+        p[a] = b;
+}
+
+/* Segments of chunk k: runs of one island's vertices (kinematic vertices
+ * inside a run do not end it). Writes them when first/isl are given. */
+static size_t chunk_segments(const pose__fem_mesh *m, const uint32_t *island, size_t k,
+                             uint32_t *first, uint32_t *isl)
+{
+    size_t b = k * POSE__FEM_CHUNK, e = b + POSE__FEM_CHUNK, n = 0;
+    if (e > m->vertex_count)
+        e = m->vertex_count;
+    uint32_t cur = POSE__FEM_KINEMATIC;
+    for (size_t v = b; v < e; v++) {
+        if (island[v] == POSE__FEM_KINEMATIC || island[v] == cur)
+            continue;
+        cur = island[v];
+        if (first) {
+            first[n] = (uint32_t)v;
+            isl[n] = cur;
+        }
+        n++;
+    }
+    return n;
+}
+
+void pose__fem_dyn_islands(const pose__fem_mesh *m, uint32_t *p, size_t *island_count,
+                           size_t *segment_count)
+{
+    const size_t nv = m->vertex_count;
+    for (size_t v = 0; v < nv; v++)
+        p[v] = (uint32_t)v;
+    for (size_t t = 0; t < m->tet_count; t++) {
+        const uint32_t *tv = m->tets[t].v;
+        for (int c = 1; c < 4; c++)
+            unite(p, tv[0], tv[c]);
+    }
+    /* The skin's volume term couples every vertex of the tets it lies in. */
+    const pose__fem_surface *s = &m->surface;
+    uint32_t anchor = POSE__FEM_KINEMATIC;
+    for (size_t i = 0; i < s->vertex_count; i++) {
+        const uint32_t *tv = s->tets + 4 * (size_t)s->tet[i];
+        for (int c = 0; c < 4; c++) {
+            if (!is_dynamic(m, tv[c]))
+                continue;
+            if (anchor == POSE__FEM_KINEMATIC)
+                anchor = tv[c];
+            unite(p, anchor, tv[c]);
+        }
+    }
+    for (size_t v = 0; v < nv; v++)
+        p[v] = find(p, (uint32_t)v);
+    /* p[v] <= v: a root is numbered before its set's other vertices read it */
+    uint32_t islands = 0;
+    for (size_t v = 0; v < nv; v++) {
+        if (!is_dynamic(m, v))
+            p[v] = POSE__FEM_KINEMATIC;
+        else if (p[v] == v)
+            p[v] = islands++;
+        else
+            p[v] = p[p[v]];
+    }
+    size_t segs = 0;
+    for (size_t k = 0; k < m->chunk_count; k++)
+        segs += chunk_segments(m, p, k, NULL, NULL);
+    *island_count = islands;
+    *segment_count = segs;
+}
+
+typedef struct layout {
+    size_t island, tet_island, seg_offset, seg_first, seg_island, x, v, bone_prev, stiff, seg_sum,
+        isl, alpha, beta, size;
+} layout;
+
+static layout layout_of(const pose__fem_mesh *m, size_t islands, size_t segs)
+{
+    const size_t nv = m->vertex_count, ni = islands > 0 ? islands : 1;
+    layout l;
+    size_t off = 0;
+#define TAKE(field, bytes) (l.field = off, off += align64(bytes))
+    TAKE(island, nv * sizeof(uint32_t));
+    TAKE(tet_island, m->tet_count * sizeof(uint32_t));
+    TAKE(seg_offset, (m->chunk_count + 1) * sizeof(uint32_t));
+    TAKE(seg_first, segs * sizeof(uint32_t));
+    TAKE(seg_island, segs * sizeof(uint32_t));
+    TAKE(x, 3 * nv * sizeof(float) + 16); /* slack: the 8-wide gathers (rt_vec.h) */
+    TAKE(v, 3 * nv * sizeof(float) + 16);
+    TAKE(bone_prev, 3 * nv * sizeof(float));
+    TAKE(stiff, nv * sizeof(float));
+    TAKE(seg_sum, 3 * segs * sizeof(double));
+    TAKE(isl, ni * sizeof(pose__fem_island));
+    TAKE(alpha, ni * sizeof(float));
+    TAKE(beta, ni * sizeof(float));
+#undef TAKE
+    l.size = off;
+    return l;
+}
+
+size_t pose__fem_dyn_size(const pose__fem_mesh *m, size_t islands, size_t segs)
+{
+    return layout_of(m, islands, segs).size;
+}
+
+void pose__fem_dyn_init(const pose__fem_mesh *m, const uint32_t *island, size_t islands,
+                        size_t segs, void *memory, pose__fem_dyn *d)
+{
+    layout l = layout_of(m, islands, segs);
+    unsigned char *b = memory;
+    memset(b, 0, l.size);
+    *d = (pose__fem_dyn){
+        .island_count = islands,
+        .segment_count = segs,
+        .island = (uint32_t *)(b + l.island),
+        .tet_island = (uint32_t *)(b + l.tet_island),
+        .seg_offset = (uint32_t *)(b + l.seg_offset),
+        .seg_first = (uint32_t *)(b + l.seg_first),
+        .seg_island = (uint32_t *)(b + l.seg_island),
+        .x = (float *)(b + l.x),
+        .v = (float *)(b + l.v),
+        .bone_prev = (float *)(b + l.bone_prev),
+        .stiff = (float *)(b + l.stiff),
+        .seg_sum = (double *)(b + l.seg_sum),
+        .isl = (pose__fem_island *)(b + l.isl),
+        .alpha = (float *)(b + l.alpha),
+        .beta = (float *)(b + l.beta),
+    };
+    memcpy(d->island, island, m->vertex_count * sizeof(uint32_t));
+    for (size_t t = 0; t < m->tet_count; t++) {
+        const uint32_t i = island[m->tets[t].v[0]];
+        d->tet_island[t] = i == POSE__FEM_KINEMATIC ? 0 : i; /* massless: never stepped */
+    }
+    size_t n = 0;
+    for (size_t k = 0; k < m->chunk_count; k++) {
+        d->seg_offset[k] = (uint32_t)n;
+        n += chunk_segments(m, island, k, d->seg_first + n, d->seg_island + n);
+    }
+    d->seg_offset[m->chunk_count] = (uint32_t)n;
+    for (size_t v = 0; v < m->vertex_count; v++)
+        if (island[v] != POSE__FEM_KINEMATIC)
+            d->isl[island[v]].mm += 3e-4 * (double)m->mass[v];
+    /* Each vertex's stiffness at rest (the trace / 3 of its 3x3 block,
+     * invariant under rotation): what the bone springs are scaled by. */
+    for (size_t t = 0; t < m->tet_count; t++) {
+        const pose__fem_tet *tt = &m->tets[t];
+        for (int c = 0; c < 4; c++) {
+            float g[3];
+            for (int a = 0; a < 3; a++)
+                g[a] = c == 0 ? -(tt->b[a] + tt->b[3 + a] + tt->b[6 + a]) : tt->b[3 * (c - 1) + a];
+            const double gg = (double)g[0] * g[0] + (double)g[1] * g[1] + (double)g[2] * g[2];
+            d->stiff[tt->v[c]] +=
+                (float)(tt->vmu * gg + ((double)tt->vkappa + tt->vmu / 3.0) * gg / 3.0);
+        }
+    }
+}
+
+void pose__fem_dyn_reset(const pose__fem_mesh *m, pose__fem_dyn *d, const float *bones)
+{
+    const size_t n = 3 * m->vertex_count;
+    memcpy(d->x, bones, n * sizeof(float));
+    memcpy(d->bone_prev, bones, n * sizeof(float));
+    memset(d->v, 0, n * sizeof(float));
+}
+
+/* ------------------------------------------------------------ passes */
+
+enum { PASS_ROTATE, PASS_FORCES, PASS_PRODUCT_V, PASS_RESIDUAL, PASS_PRODUCT, PASS_GATHER,
+       PASS_UPDATE, PASS_INTEGRATE };
+
+typedef struct step_ctx {
+    const pose__fem_mesh *mesh;
+    pose__fem_work *w;
+    pose__fem_dyn *d;
+    const pose__fem_dyn_params *prm;
+    const float *bones;
+    int pass;
+    float mscale;    /**< 1 + dt alpha: A's mass factor */
+    float kscale;    /**< dt beta + dt^2: A's stiffness factor */
+    float vol_force; /**< the volume term's force factor at x */
+} step_ctx;
+
+/* Zero-length spring stiffness of a bone node (0 for other vertices: held
+ * vertices are the ones whose Jacobi weight the mesh left at zero). */
+static inline float spring_of(const step_ctx *c, size_t v)
+{
+    return c->mesh->inv_diag[v] == 0.0f ? c->prm->coupling * c->d->stiff[v] : 0.0f;
+}
+
+/* The volume term's product scale of island i: kscale kappa_g (g . p). */
+static inline float vol_product(const step_ctx *c, uint32_t i)
+{
+    return (float)(c->kscale * c->mesh->surface.stiffness * c->d->isl[i].gp);
+}
+
+static void segment_pass(step_ctx *c, size_t s, size_t e)
+{
+    const pose__fem_mesh *m = c->mesh;
+    pose__fem_work *w = c->w;
+    pose__fem_dyn *d = c->d;
+    const pose__fem_dyn_params *prm = c->prm;
+    const uint32_t i = d->seg_island[s];
+    const pose__fem_island *is = &d->isl[i];
+    const float dt = prm->dt, alpha = d->alpha[i], beta = d->beta[i];
+    const float vp = vol_product(c, i);
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+    if (c->pass != PASS_FORCES && c->pass != PASS_RESIDUAL && !is->active)
+        goto done;
+    for (size_t v = d->seg_first[s]; v < e; v++) {
+        if (d->island[v] != i)
+            continue;
+        const float mass = m->mass[v], ks = spring_of(c, v);
+        float *r = w->r + 3 * v, *z = w->z + 3 * v, *p = w->p + 3 * v, *ap = w->ap + 3 * v;
+        float *vel = d->v + 3 * v, *pre = w->pre + 6 * v;
+        const float *gv = w->gvol + 3 * v, *x = d->x + 3 * v;
+        float f[3];
+        switch (c->pass) {
+        case PASS_FORCES: {
+            /* dt times every force at x but the damping: r holds it until
+             * the product with v is in */
+            const float *bo = c->bones + 3 * v, *bp = d->bone_prev + 3 * v;
+            pose__fem_gather(m, w->corner, v, f);
+            for (int a = 0; a < 3; a++) {
+                float fa = f[a] + c->vol_force * gv[a] + mass * prm->gravity[a];
+                /* the spring pulls toward the bone where it is at the end of
+                 * the step; its damping acts on the velocity relative to the
+                 * bone's */
+                fa += ks * (bo[a] - x[a]) + prm->beta * ks * (bo[a] - bp[a]) / dt;
+                r[a] = dt * fa;
+                s2 += (double)vel[a] * gv[a];
+            }
+            double k[6];
+            pose__fem_vertex_block(m, w->dblk, v, k);
+            for (int e6 = 0; e6 < 6; e6++)
+                k[e6] *= c->kscale;
+            const double diag = (double)c->mscale * mass + (double)c->kscale * ks;
+            k[0] += diag;
+            k[3] += diag;
+            k[5] += diag;
+            if (pose__fem_invert_block(k, pre) < 0) {
+                pre[0] = pre[3] = pre[5] = (float)(1.0 / diag);
+                pre[1] = pre[2] = pre[4] = 0.0f;
+            }
+            break;
+        }
+        case PASS_RESIDUAL: {
+            /* r = b - A v with b = M v + dt f: the warm start's residual */
+            pose__fem_gather(m, w->corner, v, f);
+            float bv[3], pb[3];
+            for (int a = 0; a < 3; a++) {
+                bv[a] = mass * vel[a] + r[a];
+                const float av = c->kscale * (f[a] + ks * vel[a]) + vp * gv[a];
+                r[a] = r[a] - (c->mscale - 1.0f) * mass * vel[a] - av;
+                p[a] = 0.0f;
+            }
+            pose__fem_apply_block(pre, bv, pb);
+            s2 += (double)bv[0] * pb[0] + (double)bv[1] * pb[1] + (double)bv[2] * pb[2];
+            pose__fem_apply_block(pre, r, z);
+            for (int a = 0; a < 3; a++) {
+                s0 += (double)r[a] * z[a];
+                s1 += (double)r[a] * r[a];
+            }
+            break;
+        }
+        case PASS_GATHER:
+            pose__fem_gather(m, w->corner, v, f);
+            for (int a = 0; a < 3; a++) {
+                p[a] = z[a] + beta * p[a];
+                ap[a] = c->mscale * mass * p[a] + c->kscale * (f[a] + ks * p[a]);
+                s0 += (double)p[a] * ap[a];
+                s2 += (double)p[a] * gv[a];
+            }
+            break;
+        case PASS_UPDATE:
+            for (int a = 0; a < 3; a++) {
+                vel[a] += alpha * p[a];
+                r[a] -= alpha * (ap[a] + vp * gv[a]);
+            }
+            pose__fem_apply_block(pre, r, z);
+            for (int a = 0; a < 3; a++) {
+                s0 += (double)r[a] * z[a];
+                s1 += (double)r[a] * r[a];
+            }
+            break;
+        default:
+            break;
+        }
+    }
+done:
+    d->seg_sum[3 * s] = s0;
+    d->seg_sum[3 * s + 1] = s1;
+    d->seg_sum[3 * s + 2] = s2;
+}
+
+/* x += dt v for the simulated vertices; the others move with their bone.
+ * Kinetic energy summed per chunk (work->partial). */
+static void integrate_chunk(step_ctx *c, size_t k)
+{
+    const pose__fem_mesh *m = c->mesh;
+    pose__fem_dyn *d = c->d;
+    const float dt = c->prm->dt;
+    size_t b = k * POSE__FEM_CHUNK, e = b + POSE__FEM_CHUNK;
+    if (e > m->vertex_count)
+        e = m->vertex_count;
+    double ke = 0.0;
+    for (size_t v = b; v < e; v++) {
+        float *x = d->x + 3 * v, *vel = d->v + 3 * v, *bp = d->bone_prev + 3 * v;
+        const float *bo = c->bones + 3 * v;
+        if (d->island[v] == POSE__FEM_KINEMATIC) {
+            for (int a = 0; a < 3; a++) {
+                vel[a] = (bo[a] - x[a]) / dt;
+                x[a] = bo[a];
+            }
+        } else {
+            for (int a = 0; a < 3; a++) {
+                x[a] += dt * vel[a];
+                ke += 0.5 * m->mass[v] * (double)vel[a] * vel[a];
+            }
+        }
+        bp[0] = bo[0];
+        bp[1] = bo[1];
+        bp[2] = bo[2];
+    }
+    c->w->partial[4 * k] = ke;
+}
+
+static void pass_task(void *ctx, unsigned part, unsigned parts)
+{
+    step_ctx *c = ctx;
+    const pose__fem_mesh *m = c->mesh;
+    pose__fem_work *w = c->w;
+    pose__fem_dyn *d = c->d;
+    if (c->pass == PASS_ROTATE || c->pass == PASS_PRODUCT_V || c->pass == PASS_PRODUCT) {
+        const size_t blocks = (m->tet_count + 7) / 8;
+        size_t b = 8 * pose__part_begin(blocks, part, parts);
+        size_t e = 8 * pose__part_begin(blocks, part + 1, parts);
+        if (e > m->tet_count)
+            e = m->tet_count;
+        if (c->pass == PASS_ROTATE)
+            pose__fem_tets_rotate(m, w, d->x, 1, b, e);
+        else if (c->pass == PASS_PRODUCT_V)
+            pose__fem_tets_product(m, w, d->v, d->v, d->beta, NULL, b, e); /* beta[0] = 0 */
+        else
+            pose__fem_tets_product(m, w, w->z, w->p, d->beta, d->tet_island, b, e);
+        return;
+    }
+    const size_t kb = pose__part_begin(m->chunk_count, part, parts);
+    const size_t ke = pose__part_begin(m->chunk_count, part + 1, parts);
+    if (c->pass == PASS_INTEGRATE) {
+        for (size_t k = kb; k < ke; k++)
+            integrate_chunk(c, k);
+        return;
+    }
+    for (size_t k = kb; k < ke; k++) {
+        size_t chunk_end = (k + 1) * POSE__FEM_CHUNK;
+        if (chunk_end > m->vertex_count)
+            chunk_end = m->vertex_count;
+        for (uint32_t s = d->seg_offset[k]; s < d->seg_offset[k + 1]; s++)
+            segment_pass(c, s, s + 1 < d->seg_offset[k + 1] ? d->seg_first[s + 1] : chunk_end);
+    }
+}
+
+/* Below this many tets the caller works alone (as pose__fem_solve). */
+#define FEM_SERIAL_TETS 4096u
+
+/* One pass; the vertex passes' sums land in each island's sum[], added
+ * segment after segment (the same order for any thread count). */
+static void run(step_ctx *c, pose__pool *pool, int pass)
+{
+    c->pass = pass;
+    if (pool && pose__pool_threads(pool) > 1 && c->mesh->tet_count >= FEM_SERIAL_TETS)
+        pose__pool_run(pool, pass_task, c);
+    else
+        pass_task(c, 0, 1);
+    if (pass != PASS_FORCES && pass != PASS_RESIDUAL && pass != PASS_GATHER && pass != PASS_UPDATE)
+        return;
+    pose__fem_dyn *d = c->d;
+    for (size_t i = 0; i < d->island_count; i++)
+        memset(d->isl[i].sum, 0, sizeof d->isl[i].sum);
+    for (size_t s = 0; s < d->segment_count; s++) {
+        double *sum = d->isl[d->seg_island[s]].sum;
+        for (int k = 0; k < 3; k++)
+            sum[k] += d->seg_sum[3 * s + k];
+    }
+}
+
+static double now(void)
+{
+    return 1e-9 * (double)pose__now_ns();
+}
+
+void pose__fem_dyn_step(const pose__fem_mesh *m, pose__fem_work *w, pose__fem_dyn *d,
+                        pose__pool *pool, const pose__fem_dyn_params *prm, const float *bones,
+                        pose__fem_dyn_stats *stats)
+{
+    pose__fem_dyn_stats st = {0};
+    const double dt = prm->dt;
+    step_ctx c = {.mesh = m, .w = w, .d = d, .prm = prm, .bones = bones,
+                  .mscale = (float)(1.0 + dt * prm->alpha),
+                  .kscale = (float)(dt * prm->beta + dt * dt)};
+    const double t0 = now();
+    const size_t ni = d->island_count;
+    for (size_t i = 0; i < (ni > 0 ? ni : 1); i++)
+        d->beta[i] = d->alpha[i] = 0.0f;
+    for (size_t i = 0; i < ni; i++) {
+        d->isl[i].gp = 0.0;
+        d->isl[i].active = 0;
+        d->isl[i].iterations = 0;
+    }
+    /* Assembly: rotations and elastic forces at x, the right-hand side, the
+     * preconditioner (blocks of A), then the residual of the warm start v. */
+    run(&c, pool, PASS_ROTATE);
+    c.vol_force = (float)pose__fem_volume_gradient(m, w, d->x);
+    run(&c, pool, PASS_FORCES);
+    for (size_t i = 0; i < ni; i++)
+        d->isl[i].gp = d->isl[i].sum[2];
+    run(&c, pool, PASS_PRODUCT_V);
+    run(&c, pool, PASS_RESIDUAL);
+    const double tol2 = (double)prm->tolerance * prm->tolerance;
+    int any = 0;
+    for (size_t i = 0; i < ni; i++) {
+        pose__fem_island *is = &d->isl[i];
+        is->rz = is->sum[0];
+        is->rr = is->sum[1];
+        is->bb = is->sum[2];
+        /* In the preconditioner's norm (P about A^-1: r^T P r measures
+         * the velocity error by its energy, b^T P b about twice the kinetic
+         * energy of the momentum b), relative to b's, but never below the
+         * island's kinetic energy at 1e-2 rig units per second: at rest b
+         * is rounding noise, not a scale. Unlike |r| <= tol |b|, light
+         * vertices' errors count by their own mass. */
+        is->stop = tol2 * (is->bb > is->mm ? is->bb : is->mm);
+        is->active = is->rz > is->stop;
+        any |= is->active;
+    }
+    const double t1 = now();
+    st.seconds_assembly = t1 - t0;
+
+    /* CG per island: one pass serves every island still iterating. */
+    for (int it = 0; it < prm->cg_iterations && any; it++) {
+        run(&c, pool, PASS_PRODUCT);
+        run(&c, pool, PASS_GATHER);
+        for (size_t i = 0; i < ni; i++) {
+            pose__fem_island *is = &d->isl[i];
+            if (!is->active)
+                continue;
+            is->gp = is->sum[2];
+            const double pap = is->sum[0] + c.kscale * m->surface.stiffness * is->gp * is->gp;
+            if (!(pap > 0.0)) {
+                is->active = 0;
+                continue;
+            }
+            d->alpha[i] = (float)(is->rz / pap);
+        }
+        run(&c, pool, PASS_UPDATE);
+        any = 0;
+        for (size_t i = 0; i < ni; i++) {
+            pose__fem_island *is = &d->isl[i];
+            if (!is->active)
+                continue;
+            const double rz = is->sum[0];
+            is->rr = is->sum[1];
+            is->iterations++;
+            d->beta[i] = (float)(rz / is->rz);
+            is->rz = rz;
+            is->active = rz > is->stop;
+            any |= is->active;
+        }
+    }
+    const double t2 = now();
+    st.seconds_cg = t2 - t1;
+    run(&c, pool, PASS_INTEGRATE);
+    for (size_t k = 0; k < m->chunk_count; k++)
+        st.kinetic_energy += w->partial[4 * k];
+    for (size_t i = 0; i < ni; i++) {
+        const pose__fem_island *is = &d->isl[i];
+        if (is->iterations > st.cg_iterations)
+            st.cg_iterations = is->iterations;
+        const double scale = is->bb > is->mm ? is->bb : is->mm;
+        const double res = scale > 0.0 ? sqrt(is->rz / scale) : 0.0;
+        if (res > st.residual)
+            st.residual = res;
+    }
+    st.seconds_assembly += now() - t2;
+    if (stats)
+        *stats = st;
+}
+
+double pose__fem_dyn_bytes(const pose__fem_mesh *m, double cg_iterations)
+{
+    const double nt = (double)m->tet_count, nv = (double)m->vertex_count;
+    /* per tet: rotate (record 64, 4 vertices 48, quaternion r+w 32, rotation
+     * record 80, corners 48, blocks 96), product with v (record 64,
+     * rotation 72, 4 vertices 48, corners 48), and two gathers of its 4
+     * corners (index + forces, + blocks in the first); per vertex: the
+     * forces and residual passes (~112 each) and the integration (80) */
+    const double assembly = nt * (368.0 + 232.0 + 4.0 * 40.0 + 4.0 * 16.0) + nv * (112.0 + 112.0 + 80.0);
+    /* per iteration: product (record 64, rotation 72, z and p at 4 vertices
+     * 96, corners 48, island 4), gather of the corners (64), and the
+     * gather (76) and update (124) passes per vertex */
+    const double iteration = nt * (284.0 + 64.0) + nv * (76.0 + 124.0);
+    return assembly + cg_iterations * iteration;
+}

@@ -1,0 +1,116 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* Dynamics of the co-rotational FEM (design §2, Otaduy et al. §5.1-5.2):
+ * backward Euler with linearized forces. Each step solves
+ *
+ *   A v' = b,  A = (1 + dt alpha) M + (dt beta + dt^2) (K + K_s),
+ *              b = M v + dt (f(x) + M g + f_s + beta K_s v_bone)
+ *
+ * for the new velocities v' (x' = x + dt v'), with f and K the forces and
+ * warped stiffness R K0 R^T of plain co-rotated linear elasticity
+ * (rotations taken at x; pose__fem_tets_rotate's linear_volume says why
+ * not the det F volume term of the quasi-static solver) plus the skin's
+ * volume term, Rayleigh damping
+ * D = alpha M + beta (K + K_s), and K_s the zero-length springs that couple
+ * every bone node (a vertex of a bone tet that is also a soft tet's) to its
+ * bone: a kinematic rigid body at the skinned position. Vertices of bone
+ * tets only are moved with their bone.
+ *
+ * Bones being kinematic, coupling islands are the connected parts of the
+ * soft tissue (tets sharing vertices; the skin's volume term joins every
+ * vertex it touches). Each island runs its own block-Jacobi preconditioned
+ * CG (its own step lengths and stopping test), warm-started from the last
+ * velocities. Reductions are summed per segment (a run of one island's
+ * vertices inside a POSE__FEM_CHUNK) and then segment after segment, so the
+ * result is the same for any thread count. Steps allocate nothing. */
+#ifndef POSE_FEM_DYNAMICS_H
+#define POSE_FEM_DYNAMICS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "fem_mesh.h"
+#include "fem_solve.h"
+#include "rt_pool.h"
+
+/** Island of a vertex the solver does not move (bone interior, massless). */
+#define POSE__FEM_KINEMATIC UINT32_MAX
+
+typedef struct pose__fem_dyn_params {
+    float dt;             /**< seconds, > 0 */
+    float alpha;          /**< Rayleigh mass damping, 1/s */
+    float beta;           /**< Rayleigh stiffness damping, s */
+    float coupling;       /**< bone springs: multiple of each node's own elastic stiffness */
+    float tolerance;      /**< per island: stop at r^T P r <= tolerance^2 max(b^T P b, mm) */
+    int cg_iterations;    /**< most CG iterations per island and step */
+    float gravity[3];     /**< rig units / s^2 */
+} pose__fem_dyn_params;
+
+typedef struct pose__fem_dyn_stats {
+    int cg_iterations;          /**< most over the islands */
+    double residual;            /**< largest sqrt(r^T P r / max(b^T P b, mm)) over the islands */
+    double kinetic_energy;      /**< 1/2 v'^T M v' after the step */
+    double seconds_assembly;    /**< rotations, forces, right-hand side, preconditioner */
+    double seconds_cg;          /**< CG iterations */
+} pose__fem_dyn_stats;
+
+/** One coupling island's CG scalars. */
+typedef struct pose__fem_island {
+    double sum[3];          /**< the last vertex pass's sums over the island */
+    double rz, rr;          /**< r . z and r . r */
+    double bb;              /**< b^T P b (P: the block-Jacobi preconditioner) */
+    double mm;              /**< 3 sum(m) (1e-2)^2: twice its kinetic energy at 1e-2 units/s */
+    double stop;            /**< tolerance^2 max(b^T P b, mm) */
+    double gp;              /**< the volume gradient . the last product's input */
+    int iterations;
+    int active;             /**< still iterating */
+} pose__fem_island;
+
+/** A state's simulation: topology (islands, segments) and the dynamic
+ *  state, in one block of pose__fem_dyn_size bytes. */
+typedef struct pose__fem_dyn {
+    size_t island_count;
+    size_t segment_count;
+    uint32_t *island;       /**< per vertex: island, or POSE__FEM_KINEMATIC */
+    uint32_t *tet_island;   /**< per simulated tet */
+    uint32_t *seg_offset;   /**< chunk_count + 1: segments of each chunk */
+    uint32_t *seg_first;    /**< segment_count: first vertex; a segment ends at the
+                                 next one's first or at its chunk's end */
+    uint32_t *seg_island;   /**< segment_count */
+    float *x, *v;           /**< 3 per vertex: simulated positions and velocities */
+    float *bone_prev;       /**< 3 per vertex: skinned positions of the last step */
+    float *stiff;           /**< per vertex: elastic stiffness (trace / 3 of its rest block) */
+    double *seg_sum;        /**< 3 per segment */
+    pose__fem_island *isl;  /**< island_count */
+    float *alpha, *beta;    /**< per island (at least one): step length, direction update */
+} pose__fem_dyn;
+
+/**
+ * Coupling islands of the mesh into `island` (per vertex, numbered in
+ * vertex order; POSE__FEM_KINEMATIC for vertices without mass or soft tet)
+ * and the counts pose__fem_dyn_size needs. Walks the mesh once.
+ */
+void pose__fem_dyn_islands(const pose__fem_mesh *mesh, uint32_t *island, size_t *island_count,
+                           size_t *segment_count);
+/** Bytes of pose__fem_dyn_init's block. */
+size_t pose__fem_dyn_size(const pose__fem_mesh *mesh, size_t island_count, size_t segment_count);
+/** Lay the block out from pose__fem_dyn_islands' result; velocities zero,
+ *  x and bone_prev at rest (pose__fem_dyn_reset before stepping). */
+void pose__fem_dyn_init(const pose__fem_mesh *mesh, const uint32_t *island, size_t island_count,
+                        size_t segment_count, void *memory, pose__fem_dyn *out);
+/** Restart at rest at the positions `bones` (3 per vertex, e.g. skinned). */
+void pose__fem_dyn_reset(const pose__fem_mesh *mesh, pose__fem_dyn *dyn, const float *bones);
+/**
+ * One step toward the skinned positions `bones` (where every bone is at the
+ * end of the step). Updates dyn->x and dyn->v; pool may be NULL.
+ */
+void pose__fem_dyn_step(const pose__fem_mesh *mesh, pose__fem_work *work, pose__fem_dyn *dyn,
+                        pose__pool *pool, const pose__fem_dyn_params *params, const float *bones,
+                        pose__fem_dyn_stats *stats);
+
+/** Bytes a step streams with `cg_iterations` iterations (benchmarks): every
+ *  array the passes read or write counted once per pass, the vertex
+ *  gathers of the tet passes included (an upper bound: neighbours share
+ *  vertices in cache). */
+double pose__fem_dyn_bytes(const pose__fem_mesh *mesh, double cg_iterations);
+
+#endif /* POSE_FEM_DYNAMICS_H */
