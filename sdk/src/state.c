@@ -303,7 +303,6 @@ pose_status pose_apply(pose_state *st)
     pose__state_transfer_pass(st);
     if (st->method == POSE_FEM)
         st->fem_stats.seconds_transfer = pose__seconds() - t0;
-    pose__state_contact(st); /* contact.c: skin out of bone, on the final positions */
     return POSE_OK;
 }
 
