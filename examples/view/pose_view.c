@@ -3,7 +3,8 @@
  * pose-view: an interactive viewer for a rig (GLFW, legacy OpenGL). Orbit,
  * pan and zoom; show or hide tissues; colour the tet mesh by a joint's
  * weight; switch LBS/DQS/CoR; pick a joint and rotate it (the rig's limits
- * apply); drive the pose from a bridge source with play/pause/step/seek.
+ * apply); drive the pose from a bridge source with play/pause/step/seek;
+ * show a slice plane of the rig's scan (pose-bake --labels), posed alike.
  */
 #include <GLFW/glfw3.h>
 #include <math.h>
@@ -16,6 +17,8 @@
 #include "ex_draw.h"
 #include "ex_motion.h"
 #include "ex_scene.h"
+#include "ex_slice_plane.h"
+#include "ex_volume_posed.h"
 #include "pose_cli.h"
 
 typedef struct viewer {
@@ -27,8 +30,24 @@ typedef struct viewer {
     int show_joints, show_help;
     double fps, last_mouse[2];
     int dragging;        /* 0, 1 orbit, 2 pan */
+    ex_volume_posed vol; /* the rig's scan, posed: opened with the first slice plane */
+    ex_slice_plane plane;
     char status[1024];
 } viewer;
+
+/* Show slice plane `axis` (-1 hides it; -2 the next one), opening the scan the first time. */
+static void show_plane(viewer *v, int axis)
+{
+    if (!v->vol.sampler && ex_volume_posed_open(&v->vol, v->sc.rig, 0, v->status, sizeof v->status) < 0)
+        return;
+    if ((axis == -2 ? ex_slice_plane_cycle(&v->plane, &v->vol) : ex_slice_plane_show(&v->plane, &v->vol, axis)) < 0)
+        snprintf(v->status, sizeof v->status, "out of memory for the slice plane");
+    else if (v->plane.axis >= 0)
+        snprintf(v->status, sizeof v->status, "slice plane: %s %d", ex_slice_plane_name(v->plane.axis),
+                 v->plane.index);
+    else
+        v->status[0] = 0;
+}
 
 static void usage(FILE *f)
 {
@@ -41,6 +60,8 @@ static void usage(FILE *f)
           "  --method lbs|dqs|cor|fem initial skinning method (default: cor when the rig has CoR data)\n"
           "  --pose JOINT=RX,RY,RZ   initial joint angles (degrees; repeatable)\n"
           "  --size WxH              window size (default 1280x800)\n"
+          "  --slice PLANE           start with a slice plane of the rig's scan (pose-bake --labels),\n"
+          "                          posed alike: axial, coronal or sagittal (key V cycles them)\n"
           "  --quit-after N          close after N frames and print the frame rate (smoke tests)\n"
           "  --json                  at exit, a JSON summary on stdout (frames, fps, method, source,\n"
           "                          clamped --pose requests) instead of the line --quit-after prints\n"
@@ -145,6 +166,15 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
         snprintf(v->status, sizeof v->status, "rest pose");
         break;
     case GLFW_KEY_J: v->show_joints = !v->show_joints; break;
+    case GLFW_KEY_V: show_plane(v, -2); break;
+    case GLFW_KEY_PAGE_UP:
+    case GLFW_KEY_PAGE_DOWN:
+        if (v->plane.axis >= 0) {
+            ex_slice_plane_move(&v->plane, &v->vol, (key == GLFW_KEY_PAGE_UP ? 1 : -1) * ((mods & GLFW_MOD_SHIFT) ? 10 : 1));
+            snprintf(v->status, sizeof v->status, "slice plane: %s %d", ex_slice_plane_name(v->plane.axis),
+                     v->plane.index);
+        }
+        break;
     case GLFW_KEY_H: v->show_help = !v->show_help; break;
     case GLFW_KEY_F: {
         float bmin[3], bmax[3];
@@ -288,6 +318,7 @@ static void hud(viewer *v, int fw, int fh)
             "1/2/3: LBS/DQS/CoR   S: skin   B/M/O/T: bones/muscles/organs/other",
             "[ ]: select joint   X/Y/Z: rotate +5 (shift -5)   R: reset   J: joints",
             "W: weights of joint   space: play   . , : step   left/right: seek 1 s",
+            "V: slice plane of the scan (axial/coronal/sagittal/off)   PgUp/PgDn: move it (shift: 10)",
             "H: hide this help   Esc: quit"};
         for (size_t i = 0; i < sizeof help / sizeof help[0]; i++)
             ex_draw_text(10, 56 + 18 * (int)i, 2, dim, help[i], fw, fh);
@@ -307,21 +338,26 @@ static void print_summary_json(viewer *v, const char *rig, long frames, double s
         printf(", \"source\": ");
         ex_json_string(stdout, ex_motion_status(v->motion));
     }
+    if (v->plane.axis >= 0)
+        printf(", \"slice\": {\"axis\": \"%s\", \"index\": %d, \"labelled_texels\": %ld, \"gl_error\": %u}",
+               ex_slice_plane_name(v->plane.axis), v->plane.index, v->plane.labelled_texels, v->plane.gl_error);
     printf("}\n");
 }
 
 int main(int argc, char **argv)
 {
-    const char *rig = NULL, *source = NULL, *map = NULL, *poses[64];
+    const char *rig = NULL, *source = NULL, *map = NULL, *poses[64], *slice = NULL;
     int npose = 0, method = -1, width = 1280, height = 800, json = 0;
     long quit_after = 0;
     char err[1024] = "";
-    enum { OPT_SOURCE = POSE_CLI_LONG_ONLY, OPT_MAP, OPT_POSE, OPT_METHOD, OPT_SIZE, OPT_QUIT_AFTER, OPT_JSON };
+    enum { OPT_SOURCE = POSE_CLI_LONG_ONLY, OPT_MAP, OPT_POSE, OPT_METHOD, OPT_SIZE, OPT_QUIT_AFTER, OPT_JSON,
+           OPT_SLICE };
     static const struct option options[] = {
         {"source", required_argument, NULL, OPT_SOURCE}, {"map", required_argument, NULL, OPT_MAP},
         {"pose", required_argument, NULL, OPT_POSE},     {"method", required_argument, NULL, OPT_METHOD},
         {"size", required_argument, NULL, OPT_SIZE},     {"quit-after", required_argument, NULL, OPT_QUIT_AFTER},
         {"json", no_argument, NULL, OPT_JSON},           {"help", no_argument, NULL, 'h'},
+        {"slice", required_argument, NULL, OPT_SLICE},
         {0}};
     pose_cli cli;
     pose_cli_begin(&cli, "pose-view", argc, argv, options);
@@ -369,6 +405,13 @@ int main(int argc, char **argv)
         case OPT_JSON:
             json = 1;
             break;
+        case OPT_SLICE:
+            if (ex_slice_plane_parse(cli.value) < -1) {
+                pose_cli_error(&cli, "--slice: expected axial, coronal, sagittal or off, got '%s'", cli.value);
+                return 2;
+            }
+            slice = cli.value;
+            break;
         default: /* POSE_CLI_ERROR: reported */
             return 2;
         }
@@ -381,6 +424,7 @@ int main(int argc, char **argv)
     viewer v;
     memset(&v, 0, sizeof v);
     v.show_help = 1;
+    v.plane.axis = -1;
     if (ex_scene_open(&v.sc, rig, err, sizeof err) < 0) {
         fprintf(stderr, "pose-view: %s\n", err);
         return 1;
@@ -406,6 +450,13 @@ int main(int argc, char **argv)
     if (source) {
         if (ex_motion_open(source, map, v.sc.rig, &v.motion, err, sizeof err) < 0)
             goto done;
+    }
+    if (slice && ex_slice_plane_parse(slice) >= 0) {
+        show_plane(&v, ex_slice_plane_parse(slice));
+        if (!v.vol.sampler) {
+            snprintf(err, sizeof err, "--slice: %.900s", v.status);
+            goto done;
+        }
     }
     /* Check for a display before GLFW does, to say what is missing in plain words. */
     const char *display = getenv("DISPLAY"), *wayland = getenv("WAYLAND_DISPLAY");
@@ -460,6 +511,11 @@ int main(int argc, char **argv)
         glfwGetFramebufferSize(win, &fw, &fh);
         static const float bg[3] = {0.13f, 0.14f, 0.17f};
         ex_draw_scene(&v.sc, &v.cam, 0, 0, fw, fh, bg);
+        if (v.plane.axis >= 0) {
+            if (ex_volume_posed_update(&v.vol, v.sc.state, err, sizeof err) < 0)
+                goto done;
+            ex_slice_plane_draw(&v.plane, &v.vol);
+        }
         if (v.show_joints)
             ex_draw_joints(&v.sc, v.joint);
         hud(&v, fw, fh);
@@ -485,6 +541,8 @@ int main(int argc, char **argv)
 done:
     if (rc)
         fprintf(stderr, "pose-view: %s\n", err);
+    ex_slice_plane_free(&v.plane); /* its texture (if any) while the context lives */
+    ex_volume_posed_close(&v.vol);
     if (win)
         glfwDestroyWindow(win);
     glfwTerminate();
