@@ -160,6 +160,17 @@ static pose_status open_parts(pose_bridge *b, pb_error *err)
         return s;
     if (clip && (s = load_clip(b, err)) < 0)
         return s;
+    if (!clip && !pb_spec_is_live(b->spec.kind)) {
+        /* A recording's duration, by a separate pass now rather than on the
+         * first pose_bridge_status_get, which would read the whole file on
+         * the host's frame; its warnings are left to the pass that plays. */
+        pb_warnings *sink = pb_warnings_install(NULL);
+        double duration;
+        s = pb_scrub_duration(b, &duration, err);
+        pb_warnings_install(sink);
+        if (s < 0)
+            return s;
+    }
     if (b->opt.play == POSE_BRIDGE_MANUAL)
         return pb_scrub_restart(b, err); /* reads and checks the source now */
     pb_runner_options ro = runner_options(b);
