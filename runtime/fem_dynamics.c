@@ -106,8 +106,8 @@ void pose__fem_dyn_islands(const pose__fem_mesh *m, uint32_t *p, size_t *island_
 }
 
 typedef struct layout {
-    size_t island, tet_island, seg_offset, seg_first, seg_island, x, v, bone_prev, stiff, seg_sum,
-        isl, alpha, beta, size;
+    size_t island, tet_island, seg_offset, seg_first, seg_island, x, v, bone_prev, stiff, kv,
+        seg_sum, isl, alpha, beta, size;
 } layout;
 
 static layout layout_of(const pose__fem_mesh *m, size_t islands, size_t segs)
@@ -125,6 +125,7 @@ static layout layout_of(const pose__fem_mesh *m, size_t islands, size_t segs)
     TAKE(v, 3 * nv * sizeof(float) + 16);
     TAKE(bone_prev, 3 * nv * sizeof(float));
     TAKE(stiff, nv * sizeof(float));
+    TAKE(kv, 12 * m->tet_count * sizeof(float));
     TAKE(seg_sum, 3 * segs * sizeof(double));
     TAKE(isl, ni * sizeof(pose__fem_island));
     TAKE(alpha, ni * sizeof(float));
@@ -157,6 +158,7 @@ void pose__fem_dyn_init(const pose__fem_mesh *m, const uint32_t *island, size_t 
         .v = (float *)(b + l.v),
         .bone_prev = (float *)(b + l.bone_prev),
         .stiff = (float *)(b + l.stiff),
+        .kv = (float *)(b + l.kv),
         .seg_sum = (double *)(b + l.seg_sum),
         .isl = (pose__fem_island *)(b + l.isl),
         .alpha = (float *)(b + l.alpha),
@@ -201,8 +203,7 @@ void pose__fem_dyn_reset(const pose__fem_mesh *m, pose__fem_dyn *d, const float 
 
 /* ------------------------------------------------------------ passes */
 
-enum { PASS_ROTATE, PASS_FORCES, PASS_PRODUCT_V, PASS_RESIDUAL, PASS_PRODUCT, PASS_GATHER,
-       PASS_UPDATE, PASS_INTEGRATE };
+enum { PASS_ROTATE, PASS_RESIDUAL, PASS_PRODUCT, PASS_GATHER, PASS_UPDATE, PASS_INTEGRATE };
 
 typedef struct step_ctx {
     const pose__fem_mesh *mesh;
@@ -240,7 +241,7 @@ static void segment_pass(step_ctx *c, size_t s, size_t e)
     const float dt = prm->dt, alpha = d->alpha[i], beta = d->beta[i];
     const float vp = vol_product(c, i);
     double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-    if (c->pass != PASS_FORCES && c->pass != PASS_RESIDUAL && !is->active)
+    if (c->pass != PASS_RESIDUAL && !is->active)
         goto done;
     for (size_t v = d->seg_first[s]; v < e; v++) {
         if (d->island[v] != i)
@@ -251,19 +252,22 @@ static void segment_pass(step_ctx *c, size_t s, size_t e)
         const float *gv = w->gvol + 3 * v, *x = d->x + 3 * v;
         float f[3];
         switch (c->pass) {
-        case PASS_FORCES: {
-            /* dt times every force at x but the damping: r holds it until
-             * the product with v is in */
+        case PASS_RESIDUAL: {
+            /* r = b - A v, b = M v + dt f: the warm start's residual, with
+             * f every force at x but the damping; the spring pulls toward
+             * the bone where it is at the end of the step, its damping acts
+             * on the velocity relative to the bone's */
             const float *bo = c->bones + 3 * v, *bp = d->bone_prev + 3 * v;
+            float kv[3], bv[3], pb[3];
             pose__fem_gather(m, w->corner, v, f);
+            pose__fem_gather(m, d->kv, v, kv);
             for (int a = 0; a < 3; a++) {
-                float fa = f[a] + c->vol_force * gv[a] + mass * prm->gravity[a];
-                /* the spring pulls toward the bone where it is at the end of
-                 * the step; its damping acts on the velocity relative to the
-                 * bone's */
-                fa += ks * (bo[a] - x[a]) + prm->beta * ks * (bo[a] - bp[a]) / dt;
-                r[a] = dt * fa;
-                s2 += (double)vel[a] * gv[a];
+                const float fa = f[a] + c->vol_force * gv[a] + mass * prm->gravity[a] +
+                                 ks * (bo[a] - x[a]) + prm->beta * ks * (bo[a] - bp[a]) / dt;
+                bv[a] = mass * vel[a] + dt * fa;
+                r[a] = dt * fa - (c->mscale - 1.0f) * mass * vel[a] -
+                       c->kscale * (kv[a] + ks * vel[a]) - vp * gv[a];
+                p[a] = 0.0f;
             }
             double k[6];
             pose__fem_vertex_block(m, w->dblk, v, k);
@@ -276,18 +280,6 @@ static void segment_pass(step_ctx *c, size_t s, size_t e)
             if (pose__fem_invert_block(k, pre) < 0) {
                 pre[0] = pre[3] = pre[5] = (float)(1.0 / diag);
                 pre[1] = pre[2] = pre[4] = 0.0f;
-            }
-            break;
-        }
-        case PASS_RESIDUAL: {
-            /* r = b - A v with b = M v + dt f: the warm start's residual */
-            pose__fem_gather(m, w->corner, v, f);
-            float bv[3], pb[3];
-            for (int a = 0; a < 3; a++) {
-                bv[a] = mass * vel[a] + r[a];
-                const float av = c->kscale * (f[a] + ks * vel[a]) + vp * gv[a];
-                r[a] = r[a] - (c->mscale - 1.0f) * mass * vel[a] - av;
-                p[a] = 0.0f;
             }
             pose__fem_apply_block(pre, bv, pb);
             s2 += (double)bv[0] * pb[0] + (double)bv[1] * pb[1] + (double)bv[2] * pb[2];
@@ -366,16 +358,14 @@ static void pass_task(void *ctx, unsigned part, unsigned parts)
     const pose__fem_mesh *m = c->mesh;
     pose__fem_work *w = c->w;
     pose__fem_dyn *d = c->d;
-    if (c->pass == PASS_ROTATE || c->pass == PASS_PRODUCT_V || c->pass == PASS_PRODUCT) {
+    if (c->pass == PASS_ROTATE || c->pass == PASS_PRODUCT) {
         const size_t blocks = (m->tet_count + 7) / 8;
         size_t b = 8 * pose__part_begin(blocks, part, parts);
         size_t e = 8 * pose__part_begin(blocks, part + 1, parts);
         if (e > m->tet_count)
             e = m->tet_count;
-        if (c->pass == PASS_ROTATE)
-            pose__fem_tets_rotate(m, w, d->x, 1, b, e);
-        else if (c->pass == PASS_PRODUCT_V)
-            pose__fem_tets_product(m, w, d->v, d->v, d->beta, NULL, b, e); /* beta[0] = 0 */
+        if (c->pass == PASS_ROTATE) /* with K v: the warm start's product */
+            pose__fem_tets_rotate(m, w, d->x, 1, d->v, d->kv, b, e);
         else
             pose__fem_tets_product(m, w, w->z, w->p, d->beta, d->tet_island, b, e);
         return;
@@ -408,7 +398,7 @@ static void run(step_ctx *c, pose__pool *pool, int pass)
         pose__pool_run(pool, pass_task, c);
     else
         pass_task(c, 0, 1);
-    if (pass != PASS_FORCES && pass != PASS_RESIDUAL && pass != PASS_GATHER && pass != PASS_UPDATE)
+    if (pass != PASS_RESIDUAL && pass != PASS_GATHER && pass != PASS_UPDATE)
         return;
     pose__fem_dyn *d = c->d;
     for (size_t i = 0; i < d->island_count; i++)
@@ -443,14 +433,18 @@ void pose__fem_dyn_step(const pose__fem_mesh *m, pose__fem_work *w, pose__fem_dy
         d->isl[i].active = 0;
         d->isl[i].iterations = 0;
     }
-    /* Assembly: rotations and elastic forces at x, the right-hand side, the
-     * preconditioner (blocks of A), then the residual of the warm start v. */
+    /* Assembly: rotations, elastic forces at x and K v in one pass over the
+     * tets, then per vertex the right-hand side, the preconditioner (blocks
+     * of A) and the residual of the warm start v. */
     run(&c, pool, PASS_ROTATE);
     c.vol_force = (float)pose__fem_volume_gradient(m, w, d->x);
-    run(&c, pool, PASS_FORCES);
-    for (size_t i = 0; i < ni; i++)
-        d->isl[i].gp = d->isl[i].sum[2];
-    run(&c, pool, PASS_PRODUCT_V);
+    if (m->surface.vertex_count > 0) /* g . v per island for the volume term's K v (serial: one order) */
+        for (size_t v = 0; v < m->vertex_count; v++) {
+            const float *g = w->gvol + 3 * v, *vel = d->v + 3 * v;
+            if (d->island[v] != POSE__FEM_KINEMATIC)
+                d->isl[d->island[v]].gp += (double)g[0] * vel[0] + (double)g[1] * vel[1] +
+                                           (double)g[2] * vel[2];
+        }
     run(&c, pool, PASS_RESIDUAL);
     const double tol2 = (double)prm->tolerance * prm->tolerance;
     int any = 0;

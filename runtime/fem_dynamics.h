@@ -79,6 +79,7 @@ typedef struct pose__fem_dyn {
     float *x, *v;           /**< 3 per vertex: simulated positions and velocities */
     float *bone_prev;       /**< 3 per vertex: skinned positions of the last step */
     float *stiff;           /**< per vertex: elastic stiffness (trace / 3 of its rest block) */
+    float *kv;              /**< 12 per tet: corner products K v of the rotate pass */
     double *seg_sum;        /**< 3 per segment */
     pose__fem_island *isl;  /**< island_count */
     float *alpha, *beta;    /**< per island (at least one): step length, direction update */

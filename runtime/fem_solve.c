@@ -248,7 +248,7 @@ typedef struct solve_ctx {
 } solve_ctx;
 
 static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const float *x, size_t t0,
-                         int linear_volume);
+                         int linear_volume, const float *v, float *kv);
 
 /* The 3x3 diagonal blocks of K at the tet's corners (symmetric, 6 floats:
  * xx xy xz yy yz zz): moving corner k by d alone gives G = d g^T, whose
@@ -285,19 +285,25 @@ static void tet_blocks(const pose__fem_tet *t, const float *rot, float *out)
 }
 
 void pose__fem_tets_rotate(const pose__fem_mesh *m, pose__fem_work *w, const float *x,
-                           int linear_volume, size_t b, size_t e)
+                           int linear_volume, const float *v, float *kv, size_t b, size_t e)
 {
     const pose__fem_tet *tets = m->tets;
     size_t t = b;
     for (; t + 8 <= e; t += 8)
-        rotate_block(tets, w, x, t, linear_volume);
+        rotate_block(tets, w, x, t, linear_volume, v, kv);
     for (size_t u = b; u < t; u++)
         tet_blocks(&tets[u], w->rot + 20 * u, w->dblk + 24 * u);
     for (; t < e; t++) {
+        const pose__fem_tet *tt = &tets[t];
         float F[9], *rot = w->rot + 20 * t;
-        tet_linearize(&tets[t], x, w->quat + 4 * t, rot, F, FEM_POLAR_STEPS, linear_volume);
-        tet_corners(&tets[t], rot, rot + 9, rot[18], F, 1, w->corner + 12 * t);
-        tet_blocks(&tets[t], rot, w->dblk + 24 * t);
+        tet_linearize(tt, x, w->quat + 4 * t, rot, F, FEM_POLAR_STEPS, linear_volume);
+        tet_corners(tt, rot, rot + 9, rot[18], F, 1, w->corner + 12 * t);
+        tet_blocks(tt, rot, w->dblk + 24 * t);
+        if (v) {
+            float G[9];
+            tet_gradient(tt, v, G);
+            tet_corners(tt, rot, rot + 9, 0.0f, G, 0, kv + 12 * t);
+        }
     }
 }
 
@@ -433,7 +439,7 @@ static void rotation_block(const pose__v8f A[9], pose__v8f q[4], pose__v8f R[9])
 }
 
 static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const float *x, size_t t0,
-                         int linear_volume)
+                         int linear_volume, const float *v, float *kv)
 {
     pose__v8f B[9], vmu, vkappa;
     uint32_t idx[4][8];
@@ -477,6 +483,17 @@ static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const flo
     }
     const pose__v8f vol = vkappa * jm1;
     corners_block(B, R, C, &vmu, &vol, F, 1, w->corner + 12 * t0);
+    if (v) { /* K v in the same pass (the dynamics' warm start) */
+        pose__v8f G[9], cg = V8_SPLAT(0.0f);
+        for (int k = 0; k < 4; k++)
+            for (int a = 0; a < 3; a++)
+                d[k][a] = V8_GATHER(v, idx[k], 3, a);
+        gradient_block(B, d, G);
+        for (int k = 0; k < 9; k++)
+            cg += C[k] * G[k];
+        const pose__v8f volv = vkappa * cg;
+        corners_block(B, R, C, &vmu, &volv, G, 0, kv + 12 * t0);
+    }
 }
 
 /* The product K p: the search direction p' = z + beta p formed per corner. */
@@ -651,7 +668,7 @@ static void pass_task(void *ctx, unsigned part, unsigned parts)
         if (e > m->tet_count)
             e = m->tet_count;
         if (c->pass == PASS_ROTATE)
-            pose__fem_tets_rotate(m, c->w, c->x, 0, b, e);
+            pose__fem_tets_rotate(m, c->w, c->x, 0, NULL, NULL, b, e);
         else
             pose__fem_tets_product(m, c->w, c->w->z, c->w->p, &c->beta, NULL, b, e);
         return;

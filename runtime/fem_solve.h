@@ -72,9 +72,11 @@ void pose__fem_solve(const pose__fem_mesh *mesh, pose__fem_work *work, pose__poo
  *  up to R's own derivative, which the dynamics need (the det F term's
  *  curvature, left out of its Gauss-Newton stiffness, is of the size of
  *  the volume stiffness itself once a tet inverts, and backward Euler
- *  integrated it explicitly: the body's swing blew up). */
+ *  integrated it explicitly: the body's swing blew up). v (may be NULL):
+ *  also the corner products K v with the new rotations into kv (12 per
+ *  tet), saving the dynamics a pass. */
 void pose__fem_tets_rotate(const pose__fem_mesh *mesh, pose__fem_work *work, const float *x,
-                           int linear_volume, size_t b, size_t e);
+                           int linear_volume, const float *v, float *kv, size_t b, size_t e);
 /** Corner products K d of the warped stiffness (the last rotate pass's)
  *  with d = z + beta p per vertex, into work->corner. beta[group[t]] per tet,
  *  or beta[0] for all when group is NULL. */
