@@ -69,10 +69,21 @@ int pv_nifti_read(const char *path, pv_image *out, char *err, size_t n)
     size_t got = 0;
     if (read_head(path, head, sizeof head, &got, err, n) < 0)
         return -1;
+    /* The size of the file that holds the voxels bounds dim x datatype before
+     * nifticlib allocates them: the .nii itself, or for a header/image pair
+     * (magic ni1/ni2) the image file beside the header. */
+    const int pair2 = got >= 8 && memcmp(head + 4, "ni2", 4) == 0;
+    const int pair = pair2 || (got >= 348 && memcmp(head + 344, "ni1", 4) == 0);
+    char *img = pair ? nifti_findimgname(path, pair2 ? NIFTI_FTYPE_NIFTI2_2 : NIFTI_FTYPE_NIFTI1_2) : NULL;
+    if (pair && !img)
+        return fail(err, n, "%s: NIfTI header field '%s': a header/image pair whose image file (.img) is missing",
+                    path, "magic");
+    const char *data_path = pair ? img : path;
     long long fsize = -1;
     struct stat st;
-    if (!is_gz(path) && stat(path, &st) == 0 && S_ISREG(st.st_mode))
+    if (!is_gz(data_path) && stat(data_path, &st) == 0 && S_ISREG(st.st_mode))
         fsize = (long long)st.st_size;
+    free(img);
     int version = pv_nifti_check_header(head, got, path, fsize, err, n);
     if (version < 0)
         return -1;

@@ -25,7 +25,8 @@ int pv_nifti_read(const char *path, pv_image *out, char *err, size_t err_size);
 
 /** Check a header only (what pv_nifti_read checks before the voxels are
  *  read); the exact header bytes are given, `name` is used in messages and
- *  `file_size` (or -1 when unknown, e.g. compressed) bounds the data.
+ *  `file_size`, the size of the file that holds the voxels (the .nii, or a
+ *  pair's .img; -1 when unknown, e.g. compressed), bounds the data.
  *  Returns the NIfTI version (1 or 2), or -1 with a message. */
 int pv_nifti_check_header(const unsigned char *hdr, size_t hdr_len, const char *name,
                           long long file_size, char *err, size_t err_size);

@@ -152,11 +152,11 @@ int pv_nifti_check_header(const unsigned char *hdr, size_t len, const char *name
                     "%g lies inside the %lld-byte header (a single .nii file has its data after "
                     "the header)",
                     vox, (long long)sz);
-    if (single && file_size >= 0) {
+    if (file_size >= 0) {
         double need = floor(vox) + (double)voxels * (double)(bits / 8);
         if ((double)file_size < need)
             return fail(err, n, name, "vox_offset",
-                        "%g + %lld voxels x %d bytes = %.0f bytes, but the file has %lld "
+                        "%g + %lld voxels x %d bytes = %.0f bytes, but the file of voxels has %lld "
                         "(truncated, or wrong dim/datatype)",
                         vox, (long long)voxels, bits / 8, need, file_size);
     }
