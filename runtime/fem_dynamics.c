@@ -359,11 +359,8 @@ static void pass_task(void *ctx, unsigned part, unsigned parts)
     pose__fem_work *w = c->w;
     pose__fem_dyn *d = c->d;
     if (c->pass == PASS_ROTATE || c->pass == PASS_PRODUCT) {
-        const size_t blocks = (m->tet_count + 7) / 8;
-        size_t b = 8 * pose__part_begin(blocks, part, parts);
-        size_t e = 8 * pose__part_begin(blocks, part + 1, parts);
-        if (e > m->tet_count)
-            e = m->tet_count;
+        size_t b, e;
+        pose__part_range8(m->tet_count, part, parts, &b, &e);
         if (c->pass == PASS_ROTATE) /* with K v: the warm start's product */
             pose__fem_tets_rotate(m, w, d->x, 1, d->v, d->kv, b, e);
         else

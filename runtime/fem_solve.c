@@ -5,6 +5,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "rt_quat.h"
 #include "rt_thread.h"
 #include "rt_vec.h"
 
@@ -67,20 +68,6 @@ void pose__fem_work_init(const pose__fem_mesh *m, void *memory, pose__fem_work *
  * iteration or frame. pose__fem_forces (tests) runs to convergence. */
 #define FEM_POLAR_STEPS 8
 
-static void quat_to_mat(const float q[4], float R[9])
-{
-    float x = q[0], y = q[1], z = q[2], s = q[3];
-    R[0] = 1.0f - 2.0f * (y * y + z * z);
-    R[1] = 2.0f * (x * y - s * z);
-    R[2] = 2.0f * (x * z + s * y);
-    R[3] = 2.0f * (x * y + s * z);
-    R[4] = 1.0f - 2.0f * (x * x + z * z);
-    R[5] = 2.0f * (y * z - s * x);
-    R[6] = 2.0f * (x * z - s * y);
-    R[7] = 2.0f * (y * z + s * x);
-    R[8] = 1.0f - 2.0f * (x * x + y * y);
-}
-
 /* Rotational part of A (row-major) by Mueller et al. 2016 ("A robust method
  * to extract the rotational part of deformations"): iterate q toward the
  * rotation maximizing tr(R^T A), starting from the last one. Unlike the
@@ -90,7 +77,7 @@ static void quat_to_mat(const float q[4], float R[9])
 static void extract_rotation(const float A[9], float q[4], float R[9], int steps)
 {
     for (int it = 0; it < steps; it++) {
-        quat_to_mat(q, R);
+        pose__quat_to_matrix(q, R);
         float om[3] = {0, 0, 0}, d = 0.0f;
         for (int c = 0; c < 3; c++) {
             float r0 = R[c], r1 = R[3 + c], r2 = R[6 + c];
@@ -121,7 +108,7 @@ static void extract_rotation(const float A[9], float q[4], float R[9], int steps
         for (int k = 0; k < 4; k++)
             q[k] = n[k] * len;
     }
-    quat_to_mat(q, R);
+    pose__quat_to_matrix(q, R);
 }
 
 /* Gradient of the field u over the tet: G = sum_i (u_i - u_0) g_i^T. */
@@ -661,12 +648,8 @@ static void pass_task(void *ctx, unsigned part, unsigned parts)
     solve_ctx *c = ctx;
     const pose__fem_mesh *m = c->mesh;
     if (c->pass == PASS_ROTATE || c->pass == PASS_PRODUCT) {
-        /* whole blocks of 8 tets per part (the product runs 8 wide) */
-        const size_t blocks = (m->tet_count + 7) / 8;
-        size_t b = 8 * pose__part_begin(blocks, part, parts);
-        size_t e = 8 * pose__part_begin(blocks, part + 1, parts);
-        if (e > m->tet_count)
-            e = m->tet_count;
+        size_t b, e; /* whole blocks of 8 tets per part (the product runs 8 wide) */
+        pose__part_range8(m->tet_count, part, parts, &b, &e);
         if (c->pass == PASS_ROTATE)
             pose__fem_tets_rotate(m, c->w, c->x, 0, NULL, NULL, b, e);
         else

@@ -89,20 +89,6 @@ void pose__bind_rotation(const float F[9], float R[9])
         R[k] = (float)out[k];
 }
 
-static void quat_matrix(const float q[4], float *R)
-{
-    float x = q[0], y = q[1], z = q[2], w = q[3];
-    R[0] = 1.0f - 2.0f * (y * y + z * z);
-    R[1] = 2.0f * (x * y - w * z);
-    R[2] = 2.0f * (x * z + w * y);
-    R[3] = 2.0f * (x * y + w * z);
-    R[4] = 1.0f - 2.0f * (x * x + z * z);
-    R[5] = 2.0f * (y * z - w * x);
-    R[6] = 2.0f * (x * z - w * y);
-    R[7] = 2.0f * (y * z + w * x);
-    R[8] = 1.0f - 2.0f * (x * x + y * y);
-}
-
 /* Posed frame f: R[9] row-major, then t[3] (a node's posed position). */
 static void frame_of(const pose__bind_mesh *mesh, const float *tet_positions,
                      const pose__xform *skin, size_t f, float *R)
@@ -110,7 +96,7 @@ static void frame_of(const pose__bind_mesh *mesh, const float *tet_positions,
     float *t = R + 9;
     if (f >= mesh->node_frames) {
         const pose__xform *x = &skin[mesh->joints[f - mesh->node_frames]];
-        quat_matrix(x->q, R);
+        pose__quat_to_matrix(x->q, R);
         memcpy(t, x->t, 3 * sizeof(float));
         return;
     }

@@ -33,4 +33,14 @@ static inline size_t pose__part_begin(size_t n, unsigned part, unsigned parts)
     return (size_t)((unsigned long long)n * part / parts);
 }
 
+/* Part `part` of n items split in whole blocks of 8 (for loops that run 8
+ * wide): items [*begin, *end). */
+static inline void pose__part_range8(size_t n, unsigned part, unsigned parts, size_t *begin, size_t *end)
+{
+    const size_t blocks = (n + 7) / 8;
+    size_t e = 8 * pose__part_begin(blocks, part + 1, parts);
+    *begin = 8 * pose__part_begin(blocks, part, parts);
+    *end = e < n ? e : n;
+}
+
 #endif /* POSE_RT_POOL_H */

@@ -54,6 +54,21 @@ static inline float pose__quat_normalize(float q[4])
 }
 
 /** out = R(q) v (out may alias v). */
+/* The rotation matrix of unit quaternion q {x,y,z,w}, row-major. */
+static inline void pose__quat_to_matrix(const float q[4], float R[9])
+{
+    const float x = q[0], y = q[1], z = q[2], w = q[3];
+    R[0] = 1.0f - 2.0f * (y * y + z * z);
+    R[1] = 2.0f * (x * y - w * z);
+    R[2] = 2.0f * (x * z + w * y);
+    R[3] = 2.0f * (x * y + w * z);
+    R[4] = 1.0f - 2.0f * (x * x + z * z);
+    R[5] = 2.0f * (y * z - w * x);
+    R[6] = 2.0f * (x * z - w * y);
+    R[7] = 2.0f * (y * z + w * x);
+    R[8] = 1.0f - 2.0f * (x * x + y * y);
+}
+
 static inline void pose__quat_rotate(float out[3], const float q[4], const float v[3])
 {
     /* v + 2w (u x v) + 2 u x (u x v), u = q.xyz */
