@@ -12,7 +12,6 @@
 #include "pb_thread.h"
 #include "pb_warn.h"
 
-
 struct pb_runner {
     pb_thread thread;
     pb_mutex mu;
