@@ -1,0 +1,68 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/*
+ * bench_contact: the cost of collision detection (pose/contact.h) per frame
+ * on a baked rig, at issue 13's poses (tests/contact/contact_body.h), with
+ * the detection's threads at 1 and 2: pose_contact_detect after one
+ * pose_apply, repeated. Printed per frame: wall milliseconds, and CPU
+ * milliseconds of the whole process divided by the threads (CPU time per
+ * thread: the figure that holds on a machine shared with other work, where
+ * wall time waits for the cores), and the counts.
+ * Usage: bench_contact RIG [--seconds S]   (S per pose and thread count, default 1)
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bench_common.h"
+#include "contact_body.h"
+#include "pose/contact.h"
+#include "pose/pose.h"
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: %s RIG [--seconds S]\n", argv[0]);
+        return 2;
+    }
+    double seconds = 1.0;
+    if (argc > 3 && strcmp(argv[2], "--seconds") == 0)
+        seconds = atof(argv[3]);
+    pose_rig *rig;
+    pose_state *st;
+    if (pose_rig_load(argv[1], &rig) != POSE_OK || pose_state_create(rig, &st) != POSE_OK) {
+        fprintf(stderr, "%s\n", pose_last_error());
+        return 1;
+    }
+    for (int threads = 1; threads <= 2; threads++) {
+        pose_contact_options o = {.size = sizeof o, .threads = threads};
+        pose_contact *c;
+        const double t0 = bench_now();
+        if (pose_contact_create(rig, &o, &c) != POSE_OK) {
+            fprintf(stderr, "%s\n", pose_last_error());
+            return 1;
+        }
+        printf("%d thread%s (index built in %.0f ms)\n", threads, threads > 1 ? "s" : "",
+               1e3 * (bench_now() - t0));
+        for (size_t p = 0; p < CONTACT_POSE_COUNT; p++) {
+            if (contact_pose_set(rig, st, &contact_poses[p]) != 0 || pose_apply(st) != POSE_OK) {
+                fprintf(stderr, "pose '%s': %s\n", contact_poses[p].label, pose_last_error());
+                return 1;
+            }
+            pose_contact_counts n = {.size = sizeof n};
+            int frames = 0;
+            const double w0 = bench_now(), c0 = bench_cpu_seconds();
+            do {
+                pose_contact_detect(c, st, &n);
+                frames++;
+            } while (bench_now() - w0 < seconds || frames < 3);
+            const double wall = (bench_now() - w0) / frames, cpu = (bench_cpu_seconds() - c0) / frames;
+            printf("  %-18s: %7.2f ms wall, %7.2f ms CPU per thread per frame; %zu skin pairs, %zu skin "
+                   "vertices in bone, %zu bone vertices out of skin\n", contact_poses[p].label, 1e3 * wall,
+                   1e3 * cpu / threads, n.skin_pairs, n.skin_in_bone, n.bone_out_of_skin);
+        }
+        pose_contact_free(c);
+    }
+    pose_state_free(st);
+    pose_rig_free(rig);
+    return 0;
+}

@@ -1,0 +1,55 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* A bounding-volume hierarchy over triangles whose vertices move: the tree's
+ * topology is built once (at rest, sdk/src/contact_build.c), its boxes are
+ * refitted to the posed vertices every frame, and queries run on it:
+ * triangle pairs that intersect (within one tree or between two), and the
+ * winding number of a point (a ray along +x). Everything here reads the
+ * tree and writes nothing shared, so queries split by part run in parallel
+ * and count the same whatever the thread count. */
+#ifndef POSE_RT_BVH_H
+#define POSE_RT_BVH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/** Triangles per leaf at most. */
+#define POSE__BVH_LEAF 4
+/** Deepest tree the builder makes (the query stacks are sized by it). */
+#define POSE__BVH_MAX_DEPTH 48
+
+/** A node: a leaf holds items[first .. first + count), an inner node
+ *  (count 0) has its children at first and first + 1. Nodes are stored
+ *  parents before children. */
+typedef struct pose__bvh_node {
+    float lo[3], hi[3];
+    uint32_t first, count;
+} pose__bvh_node;
+
+typedef struct pose__bvh {
+    pose__bvh_node *nodes;
+    uint32_t node_count;
+    const uint32_t *triangles; /**< 3 per triangle, indices into the positions */
+    uint32_t *items;           /**< triangle ids, leaf by leaf */
+    uint32_t *leaves;          /**< the leaf nodes' indices (refit splits them by part) */
+    uint32_t leaf_count;
+    /** Self-intersection work split for threads: task i < split_pairs is
+     *  the pair (children of inner node split_nodes[i]); the rest are the
+     *  subtrees split_nodes[i] tested against themselves. Together they
+     *  cover every pair of the tree once. */
+    uint32_t *split_nodes;
+    uint32_t split_pairs, split_count;
+} pose__bvh;
+
+/** Boxes of the leaves [begin, end) of leaves[] around the posed vertices. */
+void pose__bvh_refit_leaves(pose__bvh *t, const float *positions, size_t begin, size_t end);
+/** Boxes of the inner nodes from their children (after every leaf). */
+void pose__bvh_refit_inner(pose__bvh *t);
+
+/** Pairs of triangles of `t` that intersect and share no vertex, in the
+ *  self-intersection task `task` (0 .. split_count - 1). */
+size_t pose__bvh_self_task(const pose__bvh *t, const float *positions, uint32_t task);
+
+/** Winding number at p of the triangles of t (a ray along +x). */
+int pose__bvh_winding(const pose__bvh *t, const float *positions, const float *p);
+
+#endif /* POSE_RT_BVH_H */
