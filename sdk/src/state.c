@@ -239,6 +239,8 @@ void pose__state_transfer_task(void *ctx, unsigned part, unsigned parts)
     st->flagged_count[part] = pose__transfer(mesh, st->tet_positions, b, e, st->tissue_positions,
                                              st->tissue_normals, st->flagged + b * POSE__BLOCK);
     pose__state_place_outside(st, b * POSE__BLOCK, e * POSE__BLOCK); /* rig_outside.c */
+    if (st->rigid_bones)
+        pose__state_place_bones(st, b * POSE__BLOCK, e * POSE__BLOCK); /* state_bones.c */
 }
 
 /* Normals of the vertices in flat or inverted tets, from their triangles:
@@ -271,8 +273,9 @@ void pose__state_skin_pass(pose_state *st)
         pose__pool_run(st->pool, pose__state_skin_task, st);
 }
 
-void pose__state_transfer_pass(pose_state *st)
+void pose__state_transfer_pass(pose_state *st, int rigid_bones)
 {
+    st->rigid_bones = rigid_bones;
     if (serial_frame(st)) {
         pose__state_transfer_task(st, 0, 1);
         if (st->flagged_count[0] > 0)
@@ -300,7 +303,10 @@ pose_status pose_apply(pose_state *st)
         pose__state_fem_refine(st); /* state_fem.c */
         t0 = pose__seconds();
     }
-    pose__state_transfer_pass(st);
+    /* POSE_FEM's bones are rigid bodies, but the refinement moves the soft
+     * tets that hold part of each bone surface: those follow their joint.
+     * The skinning methods keep every tissue on their own field. */
+    pose__state_transfer_pass(st, st->method == POSE_FEM);
     if (st->method == POSE_FEM)
         st->fem_stats.seconds_transfer = pose__seconds() - t0;
     return POSE_OK;

@@ -14,32 +14,15 @@
 
 #include <cmocka.h>
 
+#include "fem_postures.h"
 #include "fem_volume.h"
 #include "pose/pose.h"
-
-typedef struct posture {
-    const char *name;
-    const char *joints[2];
-    float deg[3];
-} posture;
-
-/* Both sides, clinical angles; every other joint stays at rest (the
- * T-pose the body was scanned in). Arms at the sides: the shoulders'
- * neutral posture. */
-static const posture k_postures[] = {
-    {"shoulder flexion 150", {"shoulder_r", "shoulder_l"}, {150, 0, 0}},
-    {"arms at the sides", {"shoulder_r", "shoulder_l"}, {0, 0, 0}},
-    {"hip flexion 90", {"hip_r", "hip_l"}, {90, 0, 0}},
-    {"knee flexion 120", {"knee_r", "knee_l"}, {120, 0, 0}},
-    {"elbow flexion 120", {"elbow_r", "elbow_l"}, {120, 0, 0}},
-};
-#define POSTURES (sizeof k_postures / sizeof k_postures[0])
 
 static pose_rig *g_rig;
 static int g_skin = -1;
 static double g_rest_volume;
 
-static void set_posture(pose_state *st, const posture *p)
+static void set_posture(pose_state *st, const fx_posture *p)
 {
     assert_int_equal(pose_reset(st), POSE_OK);
     for (int s = 0; s < 2; s++) {
@@ -106,9 +89,9 @@ static void test_volume(void **state)
     printf("skin at rest: %.3f L; %zu tet vertices, %zu tets\n", g_rest_volume * 1e3,
            tet.vertex_count, tet.tet_count);
     double worst = 0.0;
-    for (size_t i = 0; i < POSTURES; i++) {
-        set_posture(sk, &k_postures[i]);
-        set_posture(fem, &k_postures[i]);
+    for (size_t i = 0; i < FX_POSTURES; i++) {
+        set_posture(sk, &fx_postures[i]);
+        set_posture(fem, &fx_postures[i]);
         assert_int_equal(pose_apply(sk), POSE_OK);
         assert_int_equal(pose_apply(fem), POSE_OK);
         double vs = skin_volume(sk), vf = skin_volume(fem);
@@ -117,7 +100,7 @@ static void test_volume(void **state)
         assert_int_equal(pose_get_fem_stats(fem, &fs), POSE_OK);
         printf("%-22s %s %+7.3f L (%+6.2f %%)   FEM %+7.3f L (%+6.2f %%)   %d outer, %d CG, "
                "residual %.3g\n",
-               k_postures[i].name, skinning == POSE_COR ? "CoR" : "DQS",
+               fx_postures[i].name, skinning == POSE_COR ? "CoR" : "DQS",
                (vs - g_rest_volume) * 1e3, 100 * ds, (vf - g_rest_volume) * 1e3, 100 * df,
                fs.outer_iterations, fs.cg_iterations, fs.residual);
         if (fabs(df) > worst)
@@ -144,9 +127,10 @@ static void rigid(const pose_transform *rest, const pose_transform *world, const
 }
 
 /* Bones are rigid: every vertex of one bone's tets (not shared with
- * another bone's) stays within 0.1 mm of the bone's rigid motion
- * (the joint's world frame times the inverse of its rest frame). The bone
- * surfaces, embedded partly in soft tets, are printed beside it. */
+ * another bone's), and every vertex of every bone tissue (embedded partly
+ * in soft tets, which the refinement moves), stays within 0.1 mm of the
+ * bone's rigid motion (the joint's world frame times the inverse of its
+ * rest frame). */
 static void test_bones_rigid(void **state)
 {
     (void)state;
@@ -173,8 +157,8 @@ static void test_bones_rigid(void **state)
         assert_int_equal(pose_rig_joint_info(g_rig, (int)j, &ji[j]), POSE_OK);
     double worst = 0.0, surface = 0.0;
     size_t held = 0;
-    for (size_t i = 0; i < POSTURES; i++) {
-        set_posture(st, &k_postures[i]);
+    for (size_t i = 0; i < FX_POSTURES; i++) {
+        set_posture(st, &fx_postures[i]);
         assert_int_equal(pose_apply(st), POSE_OK);
         for (size_t j = 0; j < nj; j++)
             assert_int_equal(pose_joint_world(st, (int)j, &w[j]), POSE_OK);
@@ -191,50 +175,68 @@ static void test_bones_rigid(void **state)
                 worst = e;
             held += i == 0;
         }
-        for (size_t t = 0; t < pose_rig_tissue_count(g_rig); t++) {
-            pose_tissue_info info;
-            pose_rig_tissue_info(g_rig, (int)t, &info);
-            if (info.kind != POSE_TISSUE_BONE || info.joint < 0)
-                continue;
-            double d = fx_rigid_deviation(&ji[info.joint].rest_model, &w[info.joint],
-                                          info.rest_positions, pose_tissue_positions(st, (int)t, NULL),
-                                          info.vertex_count);
-            if (d > surface)
-                surface = d;
-        }
+        double d = fx_bone_deviation(g_rig, st);
+        assert_true(d >= 0.0);
+        if (d > surface)
+            surface = d;
     }
     printf("bones: %zu tet vertices of one bone's tets, largest deviation from its rigid motion "
-           "%.4f mm; bone surfaces (embedded partly in soft tets): %.2f mm\n",
+           "%.4f mm; bone tissues (embedded partly in soft tets): %.4f mm\n",
            held, worst * 1e3, surface * 1e3);
     assert_true(held > 0);
     assert_true(worst <= 1e-4);
+    assert_true(surface <= 1e-4);
     free(ji);
     free(w);
     free(bone);
     pose_state_free(st);
 }
 
-/* 1, 2 and 3 threads: the same bits. */
+/* Every tissue's positions and normals, one after another, into out (st
+ * NULL: only count); returns the floats written. */
+static size_t tissue_outputs(const pose_state *st, float *out)
+{
+    size_t at = 0;
+    for (size_t t = 0; t < pose_rig_tissue_count(g_rig); t++) {
+        pose_tissue_info info;
+        assert_int_equal(pose_rig_tissue_info(g_rig, (int)t, &info), POSE_OK);
+        const size_t n = info.vertex_count;
+        if (st) {
+            memcpy(out + at, pose_tissue_positions(st, (int)t, NULL), 3 * n * sizeof(float));
+            memcpy(out + at + 3 * n, pose_tissue_normals(st, (int)t, NULL), 3 * n * sizeof(float));
+        }
+        at += 6 * n;
+    }
+    return at;
+}
+
+/* 1, 2 and 3 threads: the same bits, tet mesh and tissues. */
 static void test_threads(void **state)
 {
     (void)state;
     pose_tet_info tet;
     assert_int_equal(pose_rig_tet_info(g_rig, &tet), POSE_OK);
-    float *ref = malloc(3 * tet.vertex_count * sizeof(float));
+    const size_t nx = 3 * tet.vertex_count, nt = tissue_outputs(NULL, NULL);
+    float *ref = malloc((nx + 2 * nt) * sizeof(float));
     assert_non_null(ref);
+    float *ref_tissues = ref + nx, *tissues = ref_tissues + nt;
     for (int threads = 1; threads <= 3; threads++) {
         pose_state_options so = {.size = sizeof so, .threads = threads, .method = POSE_FEM};
         pose_state *st;
         assert_int_equal(pose_state_create_ex(g_rig, &so, &st), POSE_OK);
-        set_posture(st, &k_postures[0]);
+        set_posture(st, &fx_postures[0]);
         assert_int_equal(pose_apply(st), POSE_OK);
-        set_posture(st, &k_postures[4]);
+        set_posture(st, &fx_postures[4]);
         assert_int_equal(pose_apply(st), POSE_OK);
         const float *x = pose_tet_positions(st, NULL);
-        if (threads == 1)
-            memcpy(ref, x, 3 * tet.vertex_count * sizeof(float));
-        else
-            assert_memory_equal(ref, x, 3 * tet.vertex_count * sizeof(float));
+        if (threads == 1) {
+            memcpy(ref, x, nx * sizeof(float));
+            tissue_outputs(st, ref_tissues);
+        } else {
+            assert_memory_equal(ref, x, nx * sizeof(float));
+            tissue_outputs(st, tissues);
+            assert_memory_equal(ref_tissues, tissues, nt * sizeof(float));
+        }
         pose_state_free(st);
     }
     free(ref);

@@ -585,10 +585,11 @@ POSE_API pose_status pose_joint_world(const pose_state *state, int joint, pose_t
  * linear co-rotational elasticity: every vertex of a bone tet (label > 0)
  * is held where skinning put it (bones are rigid), the soft tissue
  * (label 0) moves to its elastic equilibrium, and the tissues follow by the
- * usual transfer. The simulation mesh is the rig's own tet mesh; the rig's
- * `fem` section gives the soft tissue's material. Near-incompressible
- * tissue (Poisson's ratio 0.45-0.49) keeps the body's volume where
- * skinning inflates or deflates it.
+ * usual transfer, except bone tissues: each moves exactly by its joint's
+ * rigid motion (pose_tissue_info.joint). The simulation mesh is the rig's
+ * own tet mesh; the rig's `fem` section gives the soft tissue's material.
+ * Near-incompressible tissue (Poisson's ratio 0.45-0.49) keeps the body's
+ * volume where skinning inflates or deflates it.
  *
  * Each outer iteration takes every tet's rotation from its deformation
  * (polar decomposition, started from the state's last rotations) and solves
@@ -655,7 +656,8 @@ POSE_API pose_status pose_get_fem_stats(const pose_state *state, pose_fem_stats 
  * coupling island (a connected part of the soft tissue) is solved by its
  * own block-Jacobi preconditioned conjugate gradients, warm-started from
  * the last velocities. Then the tet mesh (pose_tet_positions) and every
- * tissue (the usual transfer) show the simulated positions.
+ * tissue (the usual transfer; bone tissues by their joint's rigid motion,
+ * as POSE_FEM) show the simulated positions.
  *
  * The simulation starts at rest in the skinned pose of its first step or of
  * pose_reset_dynamics. Its buffers are allocated, with the state's
