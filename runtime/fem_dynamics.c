@@ -106,18 +106,19 @@ void pose__fem_dyn_islands(const pose__fem_mesh *m, uint32_t *p, size_t *island_
 }
 
 typedef struct layout {
-    size_t island, tet_island, seg_offset, seg_first, seg_island, x, v, bone_prev, stiff, kv,
-        seg_sum, isl, alpha, beta, size;
+    size_t island, tet_island, seg_offset, seg_first, seg_island, x, v, bone_prev, stiff, tets,
+        rot, f, kv, blk, seg_sum, isl, alpha, beta, size;
 } layout;
 
 static layout layout_of(const pose__fem_mesh *m, size_t islands, size_t segs)
 {
     const size_t nv = m->vertex_count, ni = islands > 0 ? islands : 1;
+    const size_t nb = pose__fem_dyn_blocks(m), rows = 12 * POSE__FEM_LANES * sizeof(float);
     layout l;
     size_t off = 0;
 #define TAKE(field, bytes) (l.field = off, off += align64(bytes))
     TAKE(island, nv * sizeof(uint32_t));
-    TAKE(tet_island, m->tet_count * sizeof(uint32_t));
+    TAKE(tet_island, nb * POSE__FEM_LANES * sizeof(uint32_t));
     TAKE(seg_offset, (m->chunk_count + 1) * sizeof(uint32_t));
     TAKE(seg_first, segs * sizeof(uint32_t));
     TAKE(seg_island, segs * sizeof(uint32_t));
@@ -125,7 +126,11 @@ static layout layout_of(const pose__fem_mesh *m, size_t islands, size_t segs)
     TAKE(v, 3 * nv * sizeof(float) + 16);
     TAKE(bone_prev, 3 * nv * sizeof(float));
     TAKE(stiff, nv * sizeof(float));
-    TAKE(kv, 12 * m->tet_count * sizeof(float));
+    TAKE(tets, nb * sizeof(pose__fem_dyn_tets));
+    TAKE(rot, nb * sizeof(pose__fem_dyn_rot));
+    TAKE(f, nb * rows);
+    TAKE(kv, nb * rows);
+    TAKE(blk, 2 * nb * rows);
     TAKE(seg_sum, 3 * segs * sizeof(double));
     TAKE(isl, ni * sizeof(pose__fem_island));
     TAKE(alpha, ni * sizeof(float));
@@ -158,13 +163,18 @@ void pose__fem_dyn_init(const pose__fem_mesh *m, const uint32_t *island, size_t 
         .v = (float *)(b + l.v),
         .bone_prev = (float *)(b + l.bone_prev),
         .stiff = (float *)(b + l.stiff),
+        .tets = (pose__fem_dyn_tets *)(b + l.tets),
+        .rot = (pose__fem_dyn_rot *)(b + l.rot),
+        .f = (float *)(b + l.f),
         .kv = (float *)(b + l.kv),
+        .blk = (float *)(b + l.blk),
         .seg_sum = (double *)(b + l.seg_sum),
         .isl = (pose__fem_island *)(b + l.isl),
         .alpha = (float *)(b + l.alpha),
         .beta = (float *)(b + l.beta),
     };
     memcpy(d->island, island, m->vertex_count * sizeof(uint32_t));
+    pose__fem_dyn_tets_build(m, d->tets, d->rot);
     for (size_t t = 0; t < m->tet_count; t++) {
         const uint32_t i = island[m->tets[t].v[0]];
         d->tet_island[t] = i == POSE__FEM_KINEMATIC ? 0 : i; /* massless: never stepped */
@@ -199,6 +209,7 @@ void pose__fem_dyn_reset(const pose__fem_mesh *m, pose__fem_dyn *d, const float 
     memcpy(d->x, bones, n * sizeof(float));
     memcpy(d->bone_prev, bones, n * sizeof(float));
     memset(d->v, 0, n * sizeof(float));
+    pose__fem_dyn_rot_reset(m, d->rot);
 }
 
 /* ------------------------------------------------------------ passes */
@@ -216,6 +227,34 @@ typedef struct step_ctx {
     float kscale;    /**< dt beta + dt^2: A's stiffness factor */
     float vol_force; /**< the volume term's force factor at x */
 } step_ctx;
+
+/* Sum of vertex v's corner values in a 12-row output (fem_dyn_tets.h), in
+ * the mesh's fixed corner order. */
+static inline void gather(const pose__fem_mesh *m, const float *rows, size_t v, float out[3])
+{
+    float s[3] = {0, 0, 0};
+    for (uint32_t k = m->corner_offset[v]; k < m->corner_offset[v + 1]; k++) {
+        const float *f = rows + pose__fem_dyn_corner(m->corners[k], 12);
+        s[0] += f[0];
+        s[1] += f[POSE__FEM_LANES];
+        s[2] += f[2 * POSE__FEM_LANES];
+    }
+    out[0] = s[0];
+    out[1] = s[1];
+    out[2] = s[2];
+}
+
+/* Vertex v's 3x3 stiffness block (xx xy xz yy yz zz) from the corners'. */
+static inline void vertex_block(const pose__fem_mesh *m, const float *blk, size_t v, double k[6])
+{
+    for (int e = 0; e < 6; e++)
+        k[e] = 0.0;
+    for (uint32_t i = m->corner_offset[v]; i < m->corner_offset[v + 1]; i++) {
+        const float *b = blk + pose__fem_dyn_corner(m->corners[i], 24);
+        for (int e = 0; e < 6; e++)
+            k[e] += b[e * POSE__FEM_LANES];
+    }
+}
 
 /* Zero-length spring stiffness of a bone node (0 for other vertices: held
  * vertices are the ones whose Jacobi weight the mesh left at zero). */
@@ -259,8 +298,8 @@ static void segment_pass(step_ctx *c, size_t s, size_t e)
              * on the velocity relative to the bone's */
             const float *bo = c->bones + 3 * v, *bp = d->bone_prev + 3 * v;
             float kv[3], bv[3], pb[3];
-            pose__fem_gather(m, w->corner, v, f);
-            pose__fem_gather(m, d->kv, v, kv);
+            gather(m, d->f, v, f);
+            gather(m, d->kv, v, kv);
             for (int a = 0; a < 3; a++) {
                 const float fa = f[a] + c->vol_force * gv[a] + mass * prm->gravity[a] +
                                  ks * (bo[a] - x[a]) + prm->beta * ks * (bo[a] - bp[a]) / dt;
@@ -270,7 +309,7 @@ static void segment_pass(step_ctx *c, size_t s, size_t e)
                 p[a] = 0.0f;
             }
             double k[6];
-            pose__fem_vertex_block(m, w->dblk, v, k);
+            vertex_block(m, d->blk, v, k);
             for (int e6 = 0; e6 < 6; e6++)
                 k[e6] *= c->kscale;
             const double diag = (double)c->mscale * mass + (double)c->kscale * ks;
@@ -291,7 +330,7 @@ static void segment_pass(step_ctx *c, size_t s, size_t e)
             break;
         }
         case PASS_GATHER:
-            pose__fem_gather(m, w->corner, v, f);
+            gather(m, d->f, v, f);
             for (int a = 0; a < 3; a++) {
                 p[a] = z[a] + beta * p[a];
                 ap[a] = c->mscale * mass * p[a] + c->kscale * (f[a] + ks * p[a]);
@@ -352,6 +391,10 @@ static void integrate_chunk(step_ctx *c, size_t k)
     c->w->partial[4 * k] = ke;
 }
 
+/* Most rotation extraction steps per tet and step (fem_solve.c's count:
+ * warm-started, most tets converge in a few; the rest go on next step). */
+#define FEM_POLAR_STEPS 8
+
 static void pass_task(void *ctx, unsigned part, unsigned parts)
 {
     step_ctx *c = ctx;
@@ -359,12 +402,13 @@ static void pass_task(void *ctx, unsigned part, unsigned parts)
     pose__fem_work *w = c->w;
     pose__fem_dyn *d = c->d;
     if (c->pass == PASS_ROTATE || c->pass == PASS_PRODUCT) {
-        size_t b, e;
-        pose__part_range8(m->tet_count, part, parts, &b, &e);
+        const size_t nb = pose__fem_dyn_blocks(m);
+        const size_t b = pose__part_begin(nb, part, parts), e = pose__part_begin(nb, part + 1, parts);
         if (c->pass == PASS_ROTATE) /* with K v: the warm start's product */
-            pose__fem_tets_rotate(m, w, d->x, 1, d->v, d->kv, b, e);
+            pose__fem_dyn_rotate(d->tets, d->rot, d->x, d->v, FEM_POLAR_STEPS, d->f, d->kv, d->blk,
+                                 b, e);
         else
-            pose__fem_tets_product(m, w, w->z, w->p, d->beta, d->tet_island, b, e);
+            pose__fem_dyn_product(d->tets, d->rot, w->z, w->p, d->beta, d->tet_island, d->f, b, e);
         return;
     }
     const size_t kb = pose__part_begin(m->chunk_count, part, parts);
@@ -516,15 +560,16 @@ void pose__fem_dyn_step(const pose__fem_mesh *m, pose__fem_work *w, pose__fem_dy
 double pose__fem_dyn_bytes(const pose__fem_mesh *m, double cg_iterations)
 {
     const double nt = (double)m->tet_count, nv = (double)m->vertex_count;
-    /* per tet: rotate (record 64, 4 vertices 48, quaternion r+w 32, rotation
-     * record 80, corners 48, blocks 96), product with v (record 64,
-     * rotation 72, 4 vertices 48, corners 48), and two gathers of its 4
-     * corners (index + forces, + blocks in the first); per vertex: the
-     * forces and residual passes (~112 each) and the integration (80) */
-    const double assembly = nt * (368.0 + 232.0 + 4.0 * 40.0 + 4.0 * 16.0) + nv * (112.0 + 112.0 + 80.0);
-    /* per iteration: product (record 64, rotation 72, z and p at 4 vertices
-     * 96, corners 48, island 4), gather of the corners (64), and the
-     * gather (76) and update (124) passes per vertex */
-    const double iteration = nt * (284.0 + 64.0) + nv * (76.0 + 124.0);
+    /* per tet: rotate (block constants 60, quaternion r+w 32, matrix 36,
+     * x and v at 4 corners 96, forces, K v and blocks 192), and the
+     * residual pass's gathers of its 4 corners (index 4 + forces 12 + K v
+     * 12 + block 24 each); per vertex: the forces and residual passes
+     * (~112 each) and the integration (80) */
+    const double assembly = nt * (60.0 + 32.0 + 36.0 + 96.0 + 192.0 + 4.0 * 52.0) +
+                            nv * (112.0 + 112.0 + 80.0);
+    /* per iteration: product (block constants 60, rotation 36, z and p at
+     * 4 corners 96, products 48, island 4), the gather of its corners
+     * (4 x 16), and the gather (76) and update (124) passes per vertex */
+    const double iteration = nt * (244.0 + 64.0) + nv * (76.0 + 124.0);
     return assembly + cg_iterations * iteration;
 }

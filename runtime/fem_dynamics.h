@@ -28,6 +28,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "fem_dyn_tets.h"
 #include "fem_mesh.h"
 #include "fem_solve.h"
 #include "rt_pool.h"
@@ -71,7 +72,7 @@ typedef struct pose__fem_dyn {
     size_t island_count;
     size_t segment_count;
     uint32_t *island;       /**< per vertex: island, or POSE__FEM_KINEMATIC */
-    uint32_t *tet_island;   /**< per simulated tet */
+    uint32_t *tet_island;   /**< per simulated tet, padded to whole blocks (island 0) */
     uint32_t *seg_offset;   /**< chunk_count + 1: segments of each chunk */
     uint32_t *seg_first;    /**< segment_count: first vertex; a segment ends at the
                                  next one's first or at its chunk's end */
@@ -79,7 +80,11 @@ typedef struct pose__fem_dyn {
     float *x, *v;           /**< 3 per vertex: simulated positions and velocities */
     float *bone_prev;       /**< 3 per vertex: skinned positions of the last step */
     float *stiff;           /**< per vertex: elastic stiffness (trace / 3 of its rest block) */
-    float *kv;              /**< 12 per tet: corner products K v of the rotate pass */
+    pose__fem_dyn_tets *tets;  /**< the simulated tets in blocks of 8 (fem_dyn_tets.h) */
+    pose__fem_dyn_rot *rot;    /**< per block: rotations */
+    float *f;               /**< per block, 12 rows: elastic forces, then the CG's products */
+    float *kv;              /**< per block, 12 rows: K v of the rotate pass */
+    float *blk;             /**< per block, 24 rows: the corners' stiffness blocks */
     double *seg_sum;        /**< 3 per segment */
     pose__fem_island *isl;  /**< island_count */
     float *alpha, *beta;    /**< per island (at least one): step length, direction update */

@@ -1,0 +1,95 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* The dynamics' per-tet passes (fem_dynamics.h), on the simulated tets laid
+ * out eight to a block, lane-major (structure of arrays): a block's indices,
+ * shape gradients and moduli, and its rotations, load as whole vectors and
+ * its corner outputs store as whole vectors, where the quasi-static solver's
+ * 64-byte records cost a gather per field and a transpose per output. Only
+ * the vertex values are gathered. Padding lanes of the last block have zero
+ * moduli and gradients: their outputs are zero and nobody reads them.
+ *
+ * Corner outputs are 8-lane rows per block: forces and products 12 rows
+ * (corner k's component a in row 3k + a), stiffness blocks 24 rows (corner
+ * k's xx xy xz yy yz zz in rows 6k..6k+5). pose__fem_dyn_corner gives where
+ * a mesh corner's values start; they are POSE__FEM_LANES apart.
+ *
+ * Compiled once per instruction set (fem_dyn_tets_body.h), chosen at run
+ * time as rt_kernels.h's; every variant does the same IEEE operations, so
+ * the results do not depend on the CPU either. */
+#ifndef POSE_FEM_DYN_TETS_H
+#define POSE_FEM_DYN_TETS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "fem_mesh.h"
+
+#define POSE__FEM_LANES 8u
+
+/** Eight tets' constants: 480 bytes (a multiple of 32: blocks stay aligned). */
+typedef struct pose__fem_dyn_tets {
+    uint32_t v[4][8];   /**< vertex of corner k, per lane */
+    float b[9][8];      /**< pose__fem_tet.b, per lane */
+    float vmu[8];       /**< rest volume * mu */
+    float vlambda[8];   /**< rest volume * lambda (= kappa - 2 mu / 3) */
+} pose__fem_dyn_tets;
+
+/** Eight tets' rotations: the quaternion the next extraction starts from
+ *  and its matrix (row-major), 416 bytes. */
+typedef struct pose__fem_dyn_rot {
+    float q[4][8];
+    float r[9][8];
+} pose__fem_dyn_rot;
+
+/** Blocks of the mesh's simulated tets. */
+static inline size_t pose__fem_dyn_blocks(const pose__fem_mesh *m)
+{
+    return (m->tet_count + POSE__FEM_LANES - 1) / POSE__FEM_LANES;
+}
+
+/** Offset of mesh corner c (tet * 4 + corner) in a 12-row output, or, with
+ *  rows 24, in the stiffness blocks. */
+static inline size_t pose__fem_dyn_corner(uint32_t c, size_t rows)
+{
+    return (size_t)(c >> 5) * rows * POSE__FEM_LANES + (size_t)(c & 3u) * (rows / 4) * POSE__FEM_LANES +
+           ((c >> 2) & 7u);
+}
+
+/** Lay the mesh's tets out in blocks; rotations identity. */
+void pose__fem_dyn_tets_build(const pose__fem_mesh *m, pose__fem_dyn_tets *tets,
+                              pose__fem_dyn_rot *rot);
+/** Every rotation back to identity (a restart). */
+void pose__fem_dyn_rot_reset(const pose__fem_mesh *m, pose__fem_dyn_rot *rot);
+
+/**
+ * Blocks [b, e): rotations at x (at most `steps` extraction steps from the
+ * last ones), the elastic corner forces of co-rotated linear elasticity at x
+ * into f, the products K v with the new rotations into kv (12 rows each),
+ * and the corners' diagonal stiffness blocks into blk (24 rows).
+ */
+void pose__fem_dyn_rotate(const pose__fem_dyn_tets *tets, pose__fem_dyn_rot *rot, const float *x,
+                          const float *v, int steps, float *f, float *kv, float *blk, size_t b,
+                          size_t e);
+/**
+ * Blocks [b, e): corner products K d, d = z + beta[island[t]] p per vertex,
+ * with the last rotations, into out (12 rows). island: per tet, padded to
+ * whole blocks.
+ */
+void pose__fem_dyn_product(const pose__fem_dyn_tets *tets, const pose__fem_dyn_rot *rot,
+                           const float *z, const float *p, const float *beta,
+                           const uint32_t *island, float *out, size_t b, size_t e);
+
+/* The variants behind the two above. */
+#define POSE__FEM_DYN_VARIANT_DECL(sfx)                                                          \
+    void pose__fem_dyn_rotate_##sfx(const pose__fem_dyn_tets *tets, pose__fem_dyn_rot *rot,      \
+                                    const float *x, const float *v, int steps, float *f,         \
+                                    float *kv, float *blk, size_t b, size_t e);                  \
+    void pose__fem_dyn_product_##sfx(const pose__fem_dyn_tets *tets,                             \
+                                     const pose__fem_dyn_rot *rot, const float *z,               \
+                                     const float *p, const float *beta, const uint32_t *island,  \
+                                     float *out, size_t b, size_t e);
+POSE__FEM_DYN_VARIANT_DECL(generic)
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+POSE__FEM_DYN_VARIANT_DECL(avx2)
+#endif
+
+#endif /* POSE_FEM_DYN_TETS_H */
