@@ -12,6 +12,14 @@
  * k's xx xy xz yy yz zz in rows 6k..6k+5). pose__fem_dyn_corner gives where
  * a mesh corner's values start; they are POSE__FEM_LANES apart.
  *
+ * The stress is plain co-rotated linear elasticity, volume term included
+ * (tr(R^T F) - 3, not the quasi-static solver's det F): force and warped
+ * stiffness R K0 R^T then agree up to R's own derivative, which backward
+ * Euler needs (the det F term's curvature, left out of its Gauss-Newton
+ * stiffness, is of the size of the volume stiffness itself once a tet
+ * inverts, and backward Euler integrated it explicitly: the body's swing
+ * blew up).
+ *
  * Compiled once per instruction set (fem_dyn_tets_body.h), chosen at run
  * time as rt_kernels.h's; every variant does the same IEEE operations, so
  * the results do not depend on the CPU either. */

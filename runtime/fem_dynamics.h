@@ -7,8 +7,8 @@
  *
  * for the new velocities v' (x' = x + dt v'), with f and K the forces and
  * warped stiffness R K0 R^T of plain co-rotated linear elasticity
- * (rotations taken at x; pose__fem_tets_rotate's linear_volume says why
- * not the det F volume term of the quasi-static solver) plus the skin's
+ * (rotations taken at x; fem_dyn_tets.h says why not the det F volume
+ * term of the quasi-static solver) plus the skin's
  * volume term, Rayleigh damping
  * D = alpha M + beta (K + K_s), and K_s the zero-length springs that couple
  * every bone node (a vertex of a bone tet that is also a soft tet's) to its

@@ -22,6 +22,7 @@ size_t pose__fem_work_size(const pose__fem_mesh *m)
            align64(24 * m->tet_count * sizeof(float)) + align64(6 * m->vertex_count * sizeof(float)) +
            5 * align64(3 * m->vertex_count * sizeof(float)) +
            align64(3 * m->surface.vertex_count * sizeof(float)) +
+           align64(3 * m->surface.vertex_count * sizeof(double)) +
            align64(4 * m->chunk_count * sizeof(double));
 }
 
@@ -56,6 +57,8 @@ void pose__fem_work_init(const pose__fem_mesh *m, void *memory, pose__fem_work *
     }
     w->sgrad = (float *)(b + off);
     off += align64(3 * m->surface.vertex_count * sizeof(float));
+    w->spos = (double *)(b + off);
+    off += align64(3 * m->surface.vertex_count * sizeof(double));
     w->partial = (double *)(b + off);
     pose__fem_work_reset(m, w);
 }
@@ -207,17 +210,11 @@ static inline void tet_corners(const pose__fem_tet *t, const float R[9], const f
 
 /* Rotation, cofactor and J - 1 of one tet at x, stored in rot[20]. */
 static inline void tet_linearize(const pose__fem_tet *t, const float *x, float *q, float *rot,
-                                 float F[9], int steps, int linear_volume)
+                                 float F[9], int steps)
 {
     tet_gradient(t, x, F);
     extract_rotation(F, q, rot, steps);
     rot[18] = cofactor(F, rot + 9) - 1.0f;
-    if (linear_volume) {
-        /* C = R, J - 1 = tr(R^T F) - 3: plain co-rotated linear elasticity */
-        memcpy(rot + 9, rot, 9 * sizeof(float));
-        rot[18] = rot[0] * F[0] + rot[3] * F[3] + rot[6] * F[6] + rot[1] * F[1] + rot[4] * F[4] +
-                  rot[7] * F[7] + rot[2] * F[2] + rot[5] * F[5] + rot[8] * F[8] - 3.0f;
-    }
 }
 
 /* ------------------------------------------------------------ passes */
@@ -235,8 +232,7 @@ typedef struct solve_ctx {
     float vol_product; /**< kappa_g (gvol . p) */
 } solve_ctx;
 
-static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const float *x, size_t t0,
-                         int linear_volume, const float *v, float *kv);
+static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const float *x, size_t t0);
 
 /* The 3x3 diagonal blocks of K at the tet's corners (symmetric, 6 floats:
  * xx xy xz yy yz zz): moving corner k by d alone gives G = d g^T, whose
@@ -272,26 +268,24 @@ static void tet_blocks(const pose__fem_tet *t, const float *rot, float *out)
     }
 }
 
-void pose__fem_tets_rotate(const pose__fem_mesh *m, pose__fem_work *w, const float *x,
-                           int linear_volume, const float *v, float *kv, size_t b, size_t e)
+/* Tets [b, e) (whole blocks of 8 from b): every tet's rotation, cofactor
+ * and J - 1 at x into work->rot, its elastic corner forces into
+ * work->corner, its corners' 3x3 stiffness blocks into work->dblk. */
+static void tets_rotate(const pose__fem_mesh *m, pose__fem_work *w, const float *x, size_t b,
+                        size_t e)
 {
     const pose__fem_tet *tets = m->tets;
     size_t t = b;
     for (; t + 8 <= e; t += 8)
-        rotate_block(tets, w, x, t, linear_volume, v, kv);
+        rotate_block(tets, w, x, t);
     for (size_t u = b; u < t; u++)
         tet_blocks(&tets[u], w->rot + 20 * u, w->dblk + 24 * u);
     for (; t < e; t++) {
         const pose__fem_tet *tt = &tets[t];
         float F[9], *rot = w->rot + 20 * t;
-        tet_linearize(tt, x, w->quat + 4 * t, rot, F, FEM_POLAR_STEPS, linear_volume);
+        tet_linearize(tt, x, w->quat + 4 * t, rot, F, FEM_POLAR_STEPS);
         tet_corners(tt, rot, rot + 9, rot[18], F, 1, w->corner + 12 * t);
         tet_blocks(tt, rot, w->dblk + 24 * t);
-        if (v) {
-            float G[9];
-            tet_gradient(tt, v, G);
-            tet_corners(tt, rot, rot + 9, 0.0f, G, 0, kv + 12 * t);
-        }
     }
 }
 
@@ -371,8 +365,7 @@ static POSE__INLINE void gradient_block(const pose__v8f B[9], const pose__v8f d[
                              (d[3][r] - d[0][r]) * B[6 + col];
 }
 
-static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const float *x, size_t t0,
-                         int linear_volume, const float *v, float *kv)
+static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const float *x, size_t t0)
 {
     pose__v8f B[9], vmu, vkappa;
     uint32_t idx[4][8];
@@ -397,13 +390,7 @@ static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const flo
     C[6] = F[1] * F[5] - F[2] * F[4];
     C[7] = F[2] * F[3] - F[0] * F[5];
     C[8] = F[0] * F[4] - F[1] * F[3];
-    pose__v8f jm1 = (F[0] * C[0] + F[1] * C[1] + F[2] * C[2]) - V8_SPLAT(1.0f);
-    if (linear_volume) { /* as tet_linearize */
-        for (int k = 0; k < 9; k++)
-            C[k] = R[k];
-        jm1 = R[0] * F[0] + R[3] * F[3] + R[6] * F[6] + R[1] * F[1] + R[4] * F[4] + R[7] * F[7] +
-              R[2] * F[2] + R[5] * F[5] + R[8] * F[8] - V8_SPLAT(3.0f);
-    }
+    const pose__v8f jm1 = (F[0] * C[0] + F[1] * C[1] + F[2] * C[2]) - V8_SPLAT(1.0f);
     float *rot = w->rot + 20 * t0;
     for (int l = 0; l < 8; l++) {
         for (int k = 0; k < 4; k++)
@@ -416,17 +403,6 @@ static void rotate_block(const pose__fem_tet *tets, pose__fem_work *w, const flo
     }
     const pose__v8f vol = vkappa * jm1;
     corners_block(B, R, C, &vmu, &vol, F, 1, w->corner + 12 * t0);
-    if (v) { /* K v in the same pass (the dynamics' warm start) */
-        pose__v8f G[9], cg = V8_SPLAT(0.0f);
-        for (int k = 0; k < 4; k++)
-            for (int a = 0; a < 3; a++)
-                d[k][a] = V8_GATHER(v, idx[k], 3, a);
-        gradient_block(B, d, G);
-        for (int k = 0; k < 9; k++)
-            cg += C[k] * G[k];
-        const pose__v8f volv = vkappa * cg;
-        corners_block(B, R, C, &vmu, &volv, G, 0, kv + 12 * t0);
-    }
 }
 
 /* The product K p: the search direction p' = z + beta p formed per corner. */
@@ -454,24 +430,22 @@ static void product_block(const pose__fem_tet *tets, pose__fem_work *w, const fl
     corners_block(B, R, C, &vmu, &vol, G, 0, w->corner + 12 * t0);
 }
 
-/* The next search direction p' = z + beta p is formed per corner here and
- * stored per vertex by the gather that follows, saving a pass. */
-void pose__fem_tets_product(const pose__fem_mesh *m, pose__fem_work *w, const float *z,
-                            const float *p, const float *beta, const uint32_t *group, size_t b,
-                            size_t e)
+/* Tets [b, e): corner products K d of the warped stiffness (the last
+ * rotate pass's) with d = z + beta p per vertex, into work->corner. The next
+ * search direction p' = z + beta p is formed per corner here and stored per
+ * vertex by the gather that follows, saving a pass. */
+static void tets_product(const pose__fem_mesh *m, pose__fem_work *w, const float *z,
+                         const float *p, float beta, size_t b, size_t e)
 {
     const pose__fem_tet *tets = m->tets;
     size_t t = b;
     for (; t + 8 <= e; t += 8) {
-        pose__v8f vb = V8_SPLAT(beta[0]);
-        if (group)
-            for (int l = 0; l < 8; l++)
-                vb[l] = beta[group[t + (size_t)l]];
+        const pose__v8f vb = V8_SPLAT(beta);
         product_block(tets, w, z, p, &vb, t);
     }
     for (; t < e; t++) {
         const pose__fem_tet *tt = &tets[t];
-        const float bt = beta[group ? group[t] : 0];
+        const float bt = beta;
         float d[4][3];
         for (int k = 0; k < 4; k++) {
             size_t v = 3 * (size_t)tt->v[k];
@@ -597,9 +571,9 @@ static void pass_task(void *ctx, unsigned part, unsigned parts)
         size_t b, e; /* whole blocks of 8 tets per part (the product runs 8 wide) */
         pose__part_range8(m->tet_count, part, parts, &b, &e);
         if (c->pass == PASS_ROTATE)
-            pose__fem_tets_rotate(m, c->w, c->x, 0, NULL, NULL, b, e);
+            tets_rotate(m, c->w, c->x, b, e);
         else
-            pose__fem_tets_product(m, c->w, c->w->z, c->w->p, &c->beta, NULL, b, e);
+            tets_product(m, c->w, c->w->z, c->w->p, c->beta, b, e);
         return;
     }
     size_t b = pose__part_begin(m->chunk_count, part, parts);
@@ -644,17 +618,20 @@ double pose__fem_volume_gradient(const pose__fem_mesh *m, pose__fem_work *w, con
     if (s->vertex_count == 0)
         return 0.0;
     memset(w->sgrad, 0, 3 * s->vertex_count * sizeof(float));
+    /* each surface vertex placed once, not once per triangle it is in */
+    for (size_t i = 0; i < s->vertex_count; i++) {
+        const uint32_t *t = s->tets + 4 * (size_t)s->tet[i];
+        const float *b = s->bary + 4 * i;
+        for (int a = 0; a < 3; a++)
+            w->spos[3 * i + a] =
+                (double)b[0] * x[3 * (size_t)t[0] + a] + (double)b[1] * x[3 * (size_t)t[1] + a] +
+                (double)b[2] * x[3 * (size_t)t[2] + a] + (double)b[3] * x[3 * (size_t)t[3] + a];
+    }
     double vol = 0.0;
     for (size_t f = 0; f < s->triangle_count; f++) {
         const uint32_t *tri = s->triangles + 3 * f;
-        double p[3][3];
-        for (int k = 0; k < 3; k++) {
-            const uint32_t *t = s->tets + 4 * (size_t)s->tet[tri[k]];
-            const float *b = s->bary + 4 * (size_t)tri[k];
-            for (int a = 0; a < 3; a++)
-                p[k][a] = (double)b[0] * x[3 * (size_t)t[0] + a] + (double)b[1] * x[3 * (size_t)t[1] + a] +
-                          (double)b[2] * x[3 * (size_t)t[2] + a] + (double)b[3] * x[3 * (size_t)t[3] + a];
-        }
+        const double *p[3] = {w->spos + 3 * (size_t)tri[0], w->spos + 3 * (size_t)tri[1],
+                              w->spos + 3 * (size_t)tri[2]};
         for (int k = 0; k < 3; k++) {
             const double *u = p[(k + 1) % 3], *v = p[(k + 2) % 3];
             double g[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
@@ -737,7 +714,7 @@ void pose__fem_forces(const pose__fem_mesh *m, pose__fem_work *w, const float *x
 {
     for (size_t t = 0; t < m->tet_count; t++) {
         float F[9], *rot = w->rot + 20 * t;
-        tet_linearize(&m->tets[t], x, w->quat + 4 * t, rot, F, 64, 0);
+        tet_linearize(&m->tets[t], x, w->quat + 4 * t, rot, F, 64);
         tet_corners(&m->tets[t], rot, rot + 9, rot[18], F, 1, w->corner + 12 * t);
     }
     for (size_t v = 0; v < m->vertex_count; v++)

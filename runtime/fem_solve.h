@@ -43,6 +43,7 @@ typedef struct pose__fem_work {
     float *r, *z, *p, *ap; /**< 3 per vertex */
     float *gvol;     /**< 3 per vertex: gradient of the surface's volume */
     float *sgrad;    /**< 3 per surface vertex: the same per surface vertex */
+    double *spos;    /**< 3 per surface vertex: its position (volume gradient) */
     double *partial; /**< 4 per chunk */
 } pose__fem_work;
 
@@ -60,29 +61,8 @@ void pose__fem_work_reset(const pose__fem_mesh *mesh, pose__fem_work *work);
 void pose__fem_solve(const pose__fem_mesh *mesh, pose__fem_work *work, pose__pool *pool,
                      const pose__fem_params *params, float *x, pose__fem_stats *stats);
 
-/* ---- The passes the solvers share (fem_dynamics.c runs them too). Tet
- * passes take tets [b, e) in whole blocks of 8 from b; each writes only its
- * own tets' records, so parts of one pass may run at once. */
+/* ---- Pieces the dynamics (fem_dynamics.c) share. */
 
-/** Every tet's rotation, cofactor and J - 1 at x into work->rot, its
- *  elastic corner forces into work->corner, its corners' 3x3 stiffness
- *  blocks into work->dblk. linear_volume: the volume term of plain
- *  co-rotated linear elasticity instead (the cofactor replaced by R and
- *  J - 1 by tr(R^T F) - 3): force and warped stiffness R K0 R^T then agree
- *  up to R's own derivative, which the dynamics need (the det F term's
- *  curvature, left out of its Gauss-Newton stiffness, is of the size of
- *  the volume stiffness itself once a tet inverts, and backward Euler
- *  integrated it explicitly: the body's swing blew up). v (may be NULL):
- *  also the corner products K v with the new rotations into kv (12 per
- *  tet), saving the dynamics a pass. */
-void pose__fem_tets_rotate(const pose__fem_mesh *mesh, pose__fem_work *work, const float *x,
-                           int linear_volume, const float *v, float *kv, size_t b, size_t e);
-/** Corner products K d of the warped stiffness (the last rotate pass's)
- *  with d = z + beta p per vertex, into work->corner. beta[group[t]] per tet,
- *  or beta[0] for all when group is NULL. */
-void pose__fem_tets_product(const pose__fem_mesh *mesh, pose__fem_work *work, const float *z,
-                            const float *p, const float *beta, const uint32_t *group, size_t b,
-                            size_t e);
 /** The skin volume term's gradient at x into work->gvol (serial); returns
  *  its force factor -stiffness (V - V0) (0 without a surface). */
 double pose__fem_volume_gradient(const pose__fem_mesh *mesh, pose__fem_work *work, const float *x);
