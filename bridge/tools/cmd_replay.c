@@ -2,7 +2,8 @@
  * pose-bridge replay: play a clip or a HID/CAN recording onto a rig in real
  * time through the public API (pose/bridge.h), as a host would: the bridge
  * thread plays the source, the main thread is the host's frame loop (60 Hz)
- * and applies the newest pose without waiting. */
+ * and applies the newest pose without waiting: pose_apply with --method's
+ * skinning or POSE_FEM, or pose_step (cli_replay_method.c). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -11,6 +12,7 @@
 #include <unistd.h>
 
 #include "cli_maps.h"
+#include "cli_replay_method.h"
 #include "cli_rig.h"
 #include "pose_cli.h"
 #include "pose/bridge.h"
@@ -23,9 +25,15 @@ static void help(FILE *f)
             "  SOURCE          a clip (.bvh, .amc: ASF from --skeleton, or NN.asf beside NN_MM.amc),\n"
             "                  a hid-recorder file (.hid) or a candump -l log (.log); these need --map;\n"
             "                  or any source string of pose/bridge.h (hid:VID:PID, can0 ...)\n"
-            "  --rig RIG       a .rig file (poses a pose_state and runs pose_apply each host frame),\n"
+            "  --rig RIG       a .rig file (poses a pose_state each host frame that brings a fresh pose),\n"
             "                  a .bvh/.asf whose skeleton is the rig, or 'self' (the clip's own skeleton)\n"
             "  --map MAP       mapping JSON (clips: default joints of the same name)\n"
+            "  --method M      what each fresh pose runs: lbs (default), dqs, cor or fem: pose_apply with\n"
+            "                  that method (fem: POSE_FEM, the quasi-static refinement); dynamics:\n"
+            "                  pose_step on the recording's clock, by the recorded time since the last\n"
+            "                  pose (steps of at most 1/30 s; a gap over 1 s or backwards restarts\n"
+            "                  the simulation at rest). fem and dynamics need a rig baked with FEM\n"
+            "                  data (pose-bake's default)\n"
             "  --speed X       playback speed (default 1)\n"
             "  --afap          as fast as possible (no real-time pacing)\n"
             "  --loop          wrap at the end\n"
@@ -36,7 +44,9 @@ static void help(FILE *f)
             "  --start S       start at recorded time S\n"
             "  --out FILE.bvh  record the published joint angles (flushed every pose)\n"
             "  --rt-priority N run the bridge thread SCHED_FIFO at priority N when allowed\n"
-            "  --json          print a JSON summary on stdout\n"
+            "  --json          print a JSON summary on stdout (with the method, its updates and mean wall\n"
+            "                  time; fem: mean CG iterations; dynamics: steps, simulated seconds,\n"
+            "                  last and peak kinetic energy)\n"
             "  --quiet         no status line\n"
             "Status line (stderr): time, frame (clips), poses per second, lag of the bridge thread's\n"
             "wake-ups (clips), the source's state.\n");
@@ -44,6 +54,7 @@ static void help(FILE *f)
 
 typedef struct replay_args {
     const char *source, *skeleton, *rig, *map, *out;
+    pb_replay_method method;
     double speed, rate, host_rate, duration, start;
     long frames, rt_priority;
     int afap, loop, json, quiet;
@@ -53,7 +64,8 @@ typedef struct replay_args {
 static int parse(int argc, char **argv, replay_args *a)
 {
     enum { OPT_SKELETON = POSE_CLI_LONG_ONLY, OPT_RIG, OPT_MAP, OPT_OUT, OPT_SPEED, OPT_RATE, OPT_HOST_RATE,
-           OPT_DURATION, OPT_START, OPT_FRAMES, OPT_RT_PRIORITY, OPT_AFAP, OPT_LOOP, OPT_JSON, OPT_QUIET };
+           OPT_DURATION, OPT_START, OPT_FRAMES, OPT_RT_PRIORITY, OPT_AFAP, OPT_LOOP, OPT_JSON, OPT_QUIET,
+           OPT_METHOD };
     static const struct option options[] = {
         {"skeleton", required_argument, NULL, OPT_SKELETON}, {"rig", required_argument, NULL, OPT_RIG},
         {"map", required_argument, NULL, OPT_MAP},           {"out", required_argument, NULL, OPT_OUT},
@@ -62,11 +74,13 @@ static int parse(int argc, char **argv, replay_args *a)
         {"start", required_argument, NULL, OPT_START},       {"frames", required_argument, NULL, OPT_FRAMES},
         {"rt-priority", required_argument, NULL, OPT_RT_PRIORITY}, {"afap", no_argument, NULL, OPT_AFAP},
         {"loop", no_argument, NULL, OPT_LOOP},               {"json", no_argument, NULL, OPT_JSON},
-        {"quiet", no_argument, NULL, OPT_QUIET},             {"help", no_argument, NULL, 'h'},
+        {"quiet", no_argument, NULL, OPT_QUIET},             {"method", required_argument, NULL, OPT_METHOD},
+        {"help", no_argument, NULL, 'h'},
         {0}};
     memset(a, 0, sizeof *a);
     a->speed = 1.0;
     a->host_rate = 60.0;
+    pb_replay_method_parse(NULL, &a->method);
     pose_cli cli;
     pose_cli_begin(&cli, "pose-bridge replay", argc, argv, options);
     for (int c; (c = pose_cli_next(&cli)) != POSE_CLI_END;) {
@@ -83,6 +97,10 @@ static int parse(int argc, char **argv, replay_args *a)
             break;
         case OPT_MAP:
             a->map = cli.value;
+            break;
+        case OPT_METHOD:
+            if (pb_replay_method_parse(cli.value, &a->method) < 0)
+                bad = pose_cli_error(&cli, "--method: expected " PB_REPLAY_METHODS ", got '%s'", cli.value);
             break;
         case OPT_OUT:
             a->out = cli.value;
@@ -187,6 +205,7 @@ static void print_json(const replay_args *a, const pose_rig *rig, const pose_bri
         printf(", \"recording\": ");
         pb_cli_json_string(stdout, a->out);
     }
+    pb_replay_method_json(&a->method, stdout);
     printf("}\n");
 }
 
@@ -207,6 +226,10 @@ static int run(int argc, char **argv)
     }
     if (pose_state_create(rig, &st) < 0) {
         fprintf(stderr, "pose-bridge replay: %s\n", pose_last_error());
+        goto done;
+    }
+    if (pb_replay_method_start(&a.method, st) < 0) {
+        fprintf(stderr, "pose-bridge replay: --method %s: %s\n", a.method.name, pose_last_error());
         goto done;
     }
     pose_bridge_options o = {
@@ -242,7 +265,7 @@ static int run(int argc, char **argv)
     for (;;) {
         int ended = pose_bridge_wait(br, 0);
         pose_bridge_frame fr;
-        if (pose_bridge_apply(br, st, &fr) < 0 || (fr.fresh && pose_apply(st) < 0)) {
+        if (pose_bridge_apply(br, st, &fr) < 0 || (fr.fresh && pb_replay_method_update(&a.method, st, &fr) < 0)) {
             fprintf(stderr, "pose-bridge replay: %s\n", pose_last_error());
             goto done;
         }
