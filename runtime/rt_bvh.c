@@ -191,3 +191,50 @@ int pose__bvh_winding(const pose__bvh *t, const float *positions, const float *p
     }
     return w;
 }
+
+/* The ray p + s d (s >= 0) meets node n's box, grown by a little so that
+ * float rounding in the slabs never drops a triangle the exact test counts. */
+static int ray_meets(const pose__bvh_node *n, const float *p, const float *d)
+{
+    float t0 = 0.0f, t1 = INFINITY;
+    for (int k = 0; k < 3; k++) {
+        const float pad = 1e-5f + 1e-6f * (n->hi[k] - n->lo[k]);
+        const float lo = n->lo[k] - pad - p[k], hi = n->hi[k] + pad - p[k];
+        if (d[k] == 0.0f) {
+            if (lo > 0.0f || hi < 0.0f)
+                return 0;
+            continue;
+        }
+        const float a = lo / d[k], b = hi / d[k];
+        t0 = max2(t0, min2(a, b));
+        t1 = min2(t1, max2(a, b));
+        if (t0 > t1)
+            return 0;
+    }
+    return 1;
+}
+
+int pose__bvh_winding_along(const pose__bvh *t, const float *positions, const float *p, const float *d)
+{
+    uint32_t stack[POSE__BVH_MAX_DEPTH + 2];
+    int top = 0, w = 0;
+    if (!t->node_count)
+        return 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const pose__bvh_node *n = &t->nodes[stack[--top]];
+        if (!ray_meets(n, p, d))
+            continue;
+        if (!n->count) {
+            stack[top++] = n->first;
+            stack[top++] = n->first + 1;
+            continue;
+        }
+        for (uint32_t i = n->first; i < n->first + n->count; i++) {
+            const uint32_t *tri = t->triangles + 3 * (size_t)t->items[i];
+            w += pose__ray_crossing(p, d, vertex(positions, tri[0]), vertex(positions, tri[1]),
+                                    vertex(positions, tri[2]));
+        }
+    }
+    return w;
+}

@@ -2,10 +2,11 @@
 /* A bounding-volume hierarchy over triangles whose vertices move: the tree's
  * topology is built once (at rest, sdk/src/contact_build.c), its boxes are
  * refitted to the posed vertices every frame, and queries run on it:
- * triangle pairs that intersect (within one tree or between two), and the
- * winding number of a point (a ray along +x). Everything here reads the
- * tree and writes nothing shared, so queries split by part run in parallel
- * and count the same whatever the thread count. */
+ * triangle pairs that intersect (within one tree or between two), the
+ * winding number of a point (a ray along +x), and the nearest point.
+ * Everything here reads the tree and writes nothing shared, so queries
+ * split by part run in parallel and count the same whatever the thread
+ * count. */
 #ifndef POSE_RT_BVH_H
 #define POSE_RT_BVH_H
 
@@ -51,5 +52,28 @@ size_t pose__bvh_self_task(const pose__bvh *t, const float *positions, uint32_t 
 
 /** Winding number at p of the triangles of t (a ray along +x). */
 int pose__bvh_winding(const pose__bvh *t, const float *positions, const float *p);
+
+/** As pose__bvh_winding, by the ray from p along d (any non-zero direction). */
+int pose__bvh_winding_along(const pose__bvh *t, const float *positions, const float *p, const float *d);
+
+/** Features of a triangle a nearest point lies on (vertex k, the edge from
+ *  vertex k to k + 1, the inside): they choose its pseudo-normal. */
+enum {
+    POSE__NEAR_V0, POSE__NEAR_V1, POSE__NEAR_V2,
+    POSE__NEAR_E01, POSE__NEAR_E12, POSE__NEAR_E20,
+    POSE__NEAR_FACE,
+};
+
+/** The nearest point of a tree's triangles to a point. */
+typedef struct pose__bvh_near {
+    float point[3];
+    uint32_t triangle; /**< UINT32_MAX when none is within reach */
+    int feature;       /**< POSE__NEAR_* */
+} pose__bvh_near;
+
+/** Distance from p to the nearest triangle of t within max_dist (INFINITY
+ *  and out->triangle = UINT32_MAX when none is). rt_bvh_nearest.c. */
+float pose__bvh_nearest(const pose__bvh *t, const float *positions, const float *p, float max_dist,
+                        pose__bvh_near *out);
 
 #endif /* POSE_RT_BVH_H */

@@ -77,6 +77,28 @@ static inline int pose__ray_x_crossing(const float *p, const float *a, const flo
     return area > 0.0 ? 1 : -1;
 }
 
+/* As pose__ray_x_crossing for a ray from p along any direction d: +1 where
+ * the triangle faces along the ray, -1 against it, 0 when it misses. */
+static inline int pose__ray_crossing(const float *p, const float *d, const float *a, const float *b,
+                                     const float *c)
+{
+    const double ax = (double)a[0] - p[0], ay = (double)a[1] - p[1], az = (double)a[2] - p[2];
+    const double bx = (double)b[0] - p[0], by = (double)b[1] - p[1], bz = (double)b[2] - p[2];
+    const double cx = (double)c[0] - p[0], cy = (double)c[1] - p[1], cz = (double)c[2] - p[2];
+    /* The line p + s d passes inside abc: d sees the three edges turn one way. */
+    const double e0 = d[0] * (ay * bz - az * by) + d[1] * (az * bx - ax * bz) + d[2] * (ax * by - ay * bx);
+    const double e1 = d[0] * (by * cz - bz * cy) + d[1] * (bz * cx - bx * cz) + d[2] * (bx * cy - by * cx);
+    const double e2 = d[0] * (cy * az - cz * ay) + d[1] * (cz * ax - cx * az) + d[2] * (cx * ay - cy * ax);
+    if (!((e0 > 0.0 && e1 > 0.0 && e2 > 0.0) || (e0 < 0.0 && e1 < 0.0 && e2 < 0.0)))
+        return 0;
+    /* And meets the plane ahead of p (s > 0): p behind it as seen along d. */
+    const double sp = pose__orient3(a, b, c, p);
+    const double nd = e0 + e1 + e2; /* d . (normal), the sign that matters */
+    if (!((nd > 0.0 && sp < 0.0) || (nd < 0.0 && sp > 0.0)))
+        return 0;
+    return nd > 0.0 ? 1 : -1;
+}
+
 /* Triangles (index triples) share a vertex. */
 static inline int pose__tris_share_vertex(const uint32_t *s, const uint32_t *t)
 {

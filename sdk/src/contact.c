@@ -174,6 +174,11 @@ static void refit_task(void *ctx, unsigned part, unsigned parts)
                                pose__part_begin(trees[k]->leaf_count, part + 1, parts));
 }
 
+/* Skin in bone needs the rays along +x and -x to agree: on a closed mesh
+ * they always do, on an open one (a few bone meshes are) one of them can
+ * count a crossing the other does not. */
+static const float minus_x[3] = {-1.0f, 0.0f, 0.0f};
+
 /* Self-intersection tasks dealt round-robin (neighbouring tasks are
  * neighbouring body parts, of similar cost); vertices in ranges. */
 static void detect_task(void *ctx, unsigned part, unsigned parts)
@@ -188,7 +193,9 @@ static void detect_task(void *ctx, unsigned part, unsigned parts)
                  se = pose__part_begin(c->skin_vert_count, part + 1, parts);
     for (size_t i = sb; i < se; i++) {
         const uint32_t v = c->skin_verts[i];
-        const int in = c->bone.node_count && pose__bvh_winding(&c->bone, c->positions, c->positions + 3 * (size_t)v) > 0;
+        const float *x = c->positions + 3 * (size_t)v;
+        const int in = c->bone.node_count && pose__bvh_winding(&c->bone, c->positions, x) > 0 &&
+                       pose__bvh_winding_along(&c->bone, c->positions, x, minus_x) > 0;
         c->flags[v] = in ? POSE_CONTACT_SKIN_IN_BONE : 0;
         n[COUNT_SKIN_IN_BONE] += (size_t)in;
     }

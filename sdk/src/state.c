@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "alloc.h"
+#include "contact_push.h"
 #include "error.h"
 #include "rig_outside.h"
 #include "rt_fk.h"
@@ -181,6 +182,7 @@ void pose_state_free(pose_state *st)
         pose__pool_destroy(st->pool);
         pose__free(&alloc, st->pool);
     }
+    pose__state_push_free(st);
     pose__free(&alloc, st->block);
 }
 
@@ -306,9 +308,12 @@ pose_status pose_apply(pose_state *st)
     /* POSE_FEM's bones are rigid bodies, but the refinement moves the soft
      * tets that hold part of each bone surface: those follow their joint.
      * The skinning methods keep every tissue on their own field. */
-    pose__state_transfer_pass(st, st->method == POSE_FEM);
+    /* Bones are rigid for FEM, and for the contact response, which pushes skin
+     * out of each bone as its joint moves it (contact_push.c). */
+    pose__state_transfer_pass(st, st->method == POSE_FEM || st->push_enabled);
     if (st->method == POSE_FEM)
         st->fem_stats.seconds_transfer = pose__seconds() - t0;
+    pose__state_push(st); /* contact_push.c: skin out of bone, on the final positions */
     return POSE_OK;
 }
 

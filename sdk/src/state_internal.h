@@ -53,6 +53,11 @@ struct pose_state {
     pose_dynamics_options dyn_options;
     pose_dynamics_stats dyn_stats;
 
+    struct pose__push *push;    /**< pose_set_contact_response (contact_push.c): own
+                                     allocations, NULL until first enabled */
+    int push_enabled;
+    double push_seconds;        /**< the last pass's wall time */
+
     pose__pool *pool;           /**< own allocation: replaced by pose_set_threads */
     void *block;                /**< the allocation holding everything else */
 };

@@ -9,7 +9,9 @@
  *  - skin triangle pairs that intersect, pairs sharing a vertex excepted
  *    (every tissue of kind POSE_TISSUE_SKIN, as one surface);
  *  - skin vertices inside a bone (winding number of the posed bones'
- *    triangles, all tissues of kind POSE_TISSUE_BONE);
+ *    triangles, all tissues of kind POSE_TISSUE_BONE, by rays along +x and
+ *    -x that must agree: a few bone meshes are open, and one ray through
+ *    an open mesh can count a crossing without its partner);
  *  - bone vertices outside the skin (winding number of the skin).
  * Inside and outside assume closed, outward-oriented meshes (pose-bake's
  * inputs are); touching without crossing (a vertex exactly on a face)
@@ -93,6 +95,56 @@ POSE_API pose_status pose_contact_detect(pose_contact *contact, const pose_state
  */
 POSE_API const uint8_t *pose_contact_vertex_flags(const pose_contact *contact, int tissue,
                                                   size_t *vertex_count);
+
+/*
+ * Response (issue 13 part 2): skin pushed out of bone in the kinematic
+ * methods. With it on, pose_apply ends with a position-level projection:
+ * every skin vertex inside a bone, or outside it by less than the margin,
+ * moves to the bone's nearest surface point plus the margin along the
+ * outward direction. Bones move rigidly with their joints, so each is
+ * queried in its rest frame: exact nearest triangle (a BVH of the bone's
+ * mesh), sign by angle-weighted pseudo-normals, and a coarse grid per bone
+ * that rejects far points at once. Skin inside a bone at rest (the orbits'
+ * and the mouth's, in the skull and jaw) is anatomy and is left alone.
+ *
+ * What it guarantees: a skin vertex moves once, by at most its depth in the
+ * bone plus the margin (out of the first bone in the rig's order that holds
+ * it; pushed into another, it stays there), and never when it is farther
+ * than the margin outside every bone; the same bits for any thread count. Skin normals stay as the
+ * transfer made them. Bone vertices are not moved.
+ *
+ * Cost: the first pose_set_contact_response that enables it (or changes
+ * the margin) builds the bones' structures with the state's allocator
+ * (pose_contact_response_stats.build_seconds); pose_apply allocates
+ * nothing and runs the pass on the state's threads.
+ */
+
+/** Response settings; a zeroed struct (size set or 0) is off. */
+typedef struct pose_contact_response {
+    size_t size;  /**< sizeof(pose_contact_response), or 0 */
+    int enabled;  /**< nonzero: pose_apply pushes skin out of bone */
+    float margin; /**< distance kept from bone, rig units; 0 = 0.0005 (0.5 mm in metres) */
+} pose_contact_response;
+
+/** What the last pose_apply's response did. */
+typedef struct pose_contact_response_stats {
+    size_t size;          /**< sizeof(pose_contact_response_stats), set by the caller */
+    size_t pushed;        /**< skin vertices moved */
+    float max_push;       /**< longest move, rig units */
+    float margin;         /**< the margin in effect */
+    double seconds;       /**< wall time of the pass */
+    double build_seconds; /**< building the bones' structures */
+} pose_contact_response_stats;
+
+/** Turn the response on or off (NULL: off). POSE_ERR_INVALID_ARGUMENT for
+ *  a bad size or a negative or non-finite margin; POSE_ERR_OUT_OF_MEMORY
+ *  (the response is off then). @since 0.2 */
+POSE_API pose_status pose_set_contact_response(pose_state *state, const pose_contact_response *settings);
+
+/** Statistics of the last pose_apply's response (zeros with it off);
+ *  out->size must be set. @since 0.2 */
+POSE_API pose_status pose_get_contact_response_stats(const pose_state *state,
+                                                     pose_contact_response_stats *out);
 
 #ifdef __cplusplus
 }

@@ -1,0 +1,338 @@
+/* SPDX-License-Identifier: Apache-2.0 */
+/* contact_push.h: the bones' query structures and the skin's clusters,
+ * built when the response is first enabled. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "alloc.h"
+#include "contact_build.h"
+#include "contact_push.h"
+#include "error.h"
+#include "state_internal.h"
+
+/* Grid spacing: a 64th of the bone's longest side, within [2, 8] mm (rig
+ * in metres): coarse enough to build in well under a second for the body,
+ * fine enough that only skin within a few mm of a bone needs an exact
+ * query. */
+#define CELL_MIN 0.002f
+#define CELL_MAX 0.008f
+#define CELL_DIVISIONS 64.0f
+
+static float half_diagonal(float cell)
+{
+    return 0.8660254f * cell;
+}
+
+static void normalize3(float *v)
+{
+    const float l = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (l > 0.0f)
+        for (int d = 0; d < 3; d++)
+            v[d] /= l;
+}
+
+typedef struct edge_key {
+    uint32_t a, b, slot; /* a < b; slot = 3 * triangle + k */
+} edge_key;
+
+static int cmp_edge(const void *x, const void *y)
+{
+    const edge_key *p = x, *q = y;
+    if (p->a != q->a)
+        return p->a < q->a ? -1 : 1;
+    if (p->b != q->b)
+        return p->b < q->b ? -1 : 1;
+    return p->slot < q->slot ? -1 : p->slot > q->slot;
+}
+
+/* Face, edge and angle-weighted vertex pseudo-normals of a bone. */
+static pose_status pseudo_normals(pose__push_bone *b, const pose__tissue *ts, const pose_allocator *a)
+{
+    const size_t nt = ts->triangle_count, nv = ts->vertex_count;
+    b->face_n = pose__alloc(a, 3 * nt * sizeof(float), POSE__ALIGN);
+    b->edge_n = pose__calloc(a, 9 * nt * sizeof(float), POSE__ALIGN);
+    b->vert_n = pose__calloc(a, 3 * nv * sizeof(float), POSE__ALIGN);
+    edge_key *e = pose__alloc(a, 3 * nt * sizeof *e, POSE__ALIGN);
+    if (!b->face_n || !b->edge_n || !b->vert_n || !e) {
+        pose__free(a, e);
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for a bone's normals");
+    }
+    for (size_t f = 0; f < nt; f++) {
+        const uint32_t *t = ts->triangles + 3 * f;
+        const float *x[3] = {ts->positions + 3 * (size_t)t[0], ts->positions + 3 * (size_t)t[1],
+                             ts->positions + 3 * (size_t)t[2]};
+        float *n = b->face_n + 3 * f, u[3], v[3];
+        for (int d = 0; d < 3; d++) {
+            u[d] = x[1][d] - x[0][d];
+            v[d] = x[2][d] - x[0][d];
+        }
+        n[0] = u[1] * v[2] - u[2] * v[1];
+        n[1] = u[2] * v[0] - u[0] * v[2];
+        n[2] = u[0] * v[1] - u[1] * v[0];
+        normalize3(n);
+        for (int k = 0; k < 3; k++) {
+            /* The angle of the triangle at vertex k weighs its normal there. */
+            float p[3], q[3];
+            for (int d = 0; d < 3; d++) {
+                p[d] = x[(k + 1) % 3][d] - x[k][d];
+                q[d] = x[(k + 2) % 3][d] - x[k][d];
+            }
+            normalize3(p);
+            normalize3(q);
+            const float c = p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
+            const float angle = acosf(c < -1.0f ? -1.0f : c > 1.0f ? 1.0f : c);
+            for (int d = 0; d < 3; d++)
+                b->vert_n[3 * (size_t)t[k] + (size_t)d] += angle * n[d];
+            const uint32_t i = t[k], j = t[(k + 1) % 3];
+            e[3 * f + (size_t)k] = (edge_key){i < j ? i : j, i < j ? j : i, (uint32_t)(3 * f + (size_t)k)};
+        }
+    }
+    /* An edge's pseudo-normal: the sum of its faces' normals (one face at a
+     * border of an open mesh). */
+    qsort(e, 3 * nt, sizeof *e, cmp_edge);
+    for (size_t i = 0; i < 3 * nt;) {
+        size_t j = i;
+        float s[3] = {0.0f, 0.0f, 0.0f};
+        while (j < 3 * nt && e[j].a == e[i].a && e[j].b == e[i].b) {
+            for (int d = 0; d < 3; d++)
+                s[d] += b->face_n[3 * (size_t)(e[j].slot / 3) + (size_t)d];
+            j++;
+        }
+        for (size_t k = i; k < j; k++)
+            memcpy(b->edge_n + 3 * (size_t)e[k].slot, s, sizeof s);
+        i = j;
+    }
+    pose__free(a, e);
+    return POSE_OK;
+}
+
+float pose__push_distance(const pose__push_bone *b, const float *q, float max_dist, float *closest,
+                          float *outward)
+{
+    pose__bvh_near n;
+    const float d = pose__bvh_nearest(&b->tree, b->rest, q, max_dist, &n);
+    if (n.triangle == UINT32_MAX)
+        return INFINITY;
+    const uint32_t *t = b->tree.triangles + 3 * (size_t)n.triangle;
+    const float *pn;
+    if (n.feature == POSE__NEAR_FACE)
+        pn = b->face_n + 3 * (size_t)n.triangle;
+    else if (n.feature <= POSE__NEAR_V2)
+        pn = b->vert_n + 3 * (size_t)t[n.feature - POSE__NEAR_V0];
+    else
+        pn = b->edge_n + 9 * (size_t)n.triangle + 3 * (size_t)(n.feature - POSE__NEAR_E01);
+    float r[3] = {q[0] - n.point[0], q[1] - n.point[1], q[2] - n.point[2]};
+    const float side = r[0] * pn[0] + r[1] * pn[1] + r[2] * pn[2];
+    memcpy(closest, n.point, sizeof n.point);
+    if (d > 1e-7f) {
+        const float s = side >= 0.0f ? 1.0f / d : -1.0f / d;
+        for (int k = 0; k < 3; k++)
+            outward[k] = r[k] * s;
+    } else {
+        memcpy(outward, pn, 3 * sizeof(float));
+        normalize3(outward);
+    }
+    return side >= 0.0f ? d : -d;
+}
+
+/* The bone's sphere and grid: each cell's centre tells the state of the
+ * whole cell (a surface within margin + half a diagonal of the centre, or
+ * none, with the centre inside or out by the winding number). */
+static pose_status bone_grid(pose__push_bone *b, const pose__tissue *ts, float margin, const pose_allocator *a)
+{
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t v = 0; v < ts->vertex_count; v++)
+        for (int d = 0; d < 3; d++) {
+            lo[d] = fminf(lo[d], ts->positions[3 * v + (size_t)d]);
+            hi[d] = fmaxf(hi[d], ts->positions[3 * v + (size_t)d]);
+        }
+    float longest = 0.0f;
+    for (int d = 0; d < 3; d++) {
+        b->center[d] = 0.5f * (lo[d] + hi[d]);
+        longest = fmaxf(longest, hi[d] - lo[d]);
+    }
+    b->radius = 0.0f;
+    for (size_t v = 0; v < ts->vertex_count; v++) {
+        const float *x = ts->positions + 3 * v;
+        const float dx = x[0] - b->center[0], dy = x[1] - b->center[1], dz = x[2] - b->center[2];
+        b->radius = fmaxf(b->radius, sqrtf(dx * dx + dy * dy + dz * dz));
+    }
+    b->cell = fminf(fmaxf(longest / CELL_DIVISIONS, CELL_MIN), CELL_MAX);
+    const float pad = margin + b->cell;
+    size_t cells = 1;
+    for (int d = 0; d < 3; d++) {
+        b->lo[d] = lo[d] - pad;
+        b->dim[d] = (int)ceilf((hi[d] + pad - b->lo[d]) / b->cell);
+        b->hi[d] = b->lo[d] + (float)b->dim[d] * b->cell;
+        cells *= (size_t)b->dim[d];
+    }
+    b->cells = pose__alloc(a, cells, POSE__ALIGN);
+    if (!b->cells)
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for a bone grid of %zu cells", cells);
+    const float reach = margin + half_diagonal(b->cell);
+    for (int z = 0; z < b->dim[2]; z++)
+        for (int y = 0; y < b->dim[1]; y++)
+            for (int x = 0; x < b->dim[0]; x++) {
+                const float c[3] = {b->lo[0] + ((float)x + 0.5f) * b->cell, b->lo[1] + ((float)y + 0.5f) * b->cell,
+                                    b->lo[2] + ((float)z + 0.5f) * b->cell};
+                pose__bvh_near n;
+                uint8_t state;
+                if (pose__bvh_nearest(&b->tree, b->rest, c, reach, &n) <= reach)
+                    state = POSE__CELL_NEAR;
+                else
+                    state = pose__bvh_winding(&b->tree, b->rest, c) > 0 ? POSE__CELL_IN : POSE__CELL_OUT;
+                b->cells[((size_t)z * (size_t)b->dim[1] + (size_t)y) * (size_t)b->dim[0] + (size_t)x] = state;
+            }
+    return POSE_OK;
+}
+
+typedef struct morton_key {
+    uint64_t key;
+    uint32_t vertex;
+} morton_key;
+
+static int cmp_morton(const void *x, const void *y)
+{
+    const morton_key *p = x, *q = y;
+    if (p->key != q->key)
+        return p->key < q->key ? -1 : 1;
+    return p->vertex < q->vertex ? -1 : p->vertex > q->vertex;
+}
+
+static uint64_t spread(uint64_t v) /* 21 bits -> every third bit */
+{
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffull;
+    v = (v | v << 16) & 0x1f0000ff0000ffull;
+    v = (v | v << 8) & 0x100f00f00f00f00full;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ull;
+    v = (v | v << 2) & 0x1249249249249249ull;
+    return v;
+}
+
+/* Skin vertices in Morton order of their rest positions: consecutive runs
+ * of POSE__PUSH_CLUSTER are compact clusters. */
+static pose_status skin_order(pose__push *p, const pose_state *st)
+{
+    const pose_rig *rig = st->rig;
+    size_t n = 0;
+    for (size_t t = 0; t < rig->tissue_count; t++)
+        if (rig->tissues[t].kind == POSE_TISSUE_SKIN)
+            n += rig->tissues[t].vertex_count;
+    p->vertex_count = n;
+    p->cluster_count = (n + POSE__PUSH_CLUSTER - 1) / POSE__PUSH_CLUSTER;
+    p->order = pose__alloc(&p->allocator, (n + 1) * sizeof *p->order, POSE__ALIGN);
+    p->skip = pose__calloc(&p->allocator, n + 1, POSE__ALIGN);
+    morton_key *k = pose__alloc(&p->allocator, (n + 1) * sizeof *k, POSE__ALIGN);
+    if (!p->order || !p->skip || !k) {
+        pose__free(&p->allocator, k);
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu skin vertices", n);
+    }
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t t = 0; t < rig->tissue_count; t++)
+        if (rig->tissues[t].kind == POSE_TISSUE_SKIN)
+            for (size_t v = 0; v < 3 * rig->tissues[t].vertex_count; v++) {
+                lo[v % 3] = fminf(lo[v % 3], rig->tissues[t].positions[v]);
+                hi[v % 3] = fmaxf(hi[v % 3], rig->tissues[t].positions[v]);
+            }
+    size_t i = 0;
+    for (size_t t = 0; t < rig->tissue_count; t++) {
+        const pose__tissue *ts = &rig->tissues[t];
+        if (ts->kind != POSE_TISSUE_SKIN)
+            continue;
+        for (size_t v = 0; v < ts->vertex_count; v++, i++) {
+            uint64_t key = 0;
+            for (int d = 0; d < 3; d++) {
+                const float e = hi[d] > lo[d] ? (ts->positions[3 * v + (size_t)d] - lo[d]) / (hi[d] - lo[d]) : 0.0f;
+                key |= spread((uint64_t)(e * 1048575.0f)) << d;
+            }
+            k[i] = (morton_key){key, (uint32_t)(st->rt->tissue_offset[t] + v)};
+        }
+    }
+    qsort(k, n, sizeof *k, cmp_morton);
+    for (i = 0; i < n; i++)
+        p->order[i] = k[i].vertex;
+    pose__free(&p->allocator, k);
+    return POSE_OK;
+}
+
+/* Skin inside a bone at rest is anatomy (the orbits' and the mouth's skin in
+ * the skull and jaw): those vertices are left where skinning puts them. */
+static void mark_rest_inside(pose__push *p, const pose_state *st)
+{
+    const float *rest = NULL;
+    for (size_t i = 0; i < p->vertex_count; i++) {
+        const uint32_t v = p->order[i];
+        size_t t = 0;
+        while (st->rt->tissue_offset[t + 1] <= v)
+            t++;
+        rest = st->rig->tissues[t].positions + 3 * (v - st->rt->tissue_offset[t]);
+        for (size_t j = 0; j < p->bone_count && !p->skip[i]; j++) {
+            const pose__push_bone *b = &p->bones[j];
+            float c[3], o[3];
+            if (rest[0] < b->lo[0] || rest[1] < b->lo[1] || rest[2] < b->lo[2] || rest[0] >= b->hi[0] ||
+                rest[1] >= b->hi[1] || rest[2] >= b->hi[2])
+                continue;
+            p->skip[i] = pose__push_distance(b, rest, INFINITY, c, o) < 0.0f;
+        }
+    }
+}
+
+void pose__push_release(pose__push *p)
+{
+    const pose_allocator *a = &p->allocator;
+    for (size_t j = 0; p->bones && j < p->bone_count; j++) {
+        pose__push_bone *b = &p->bones[j];
+        pose__bvh_release(&b->tree, a);
+        pose__free(a, b->face_n);
+        pose__free(a, b->edge_n);
+        pose__free(a, b->vert_n);
+        pose__free(a, b->cells);
+    }
+    pose__free(a, p->bones);
+    pose__free(a, p->order);
+    pose__free(a, p->skip);
+    pose__free(a, p->frames);
+    pose__free(a, p->bone_spheres);
+    const pose_allocator keep = *a;
+    memset(p, 0, sizeof *p);
+    p->allocator = keep;
+}
+
+pose_status pose__push_build(pose__push *p, const pose_state *st, float margin)
+{
+    const double t0 = pose__seconds();
+    const pose_rig *rig = st->rig;
+    p->margin = margin;
+    size_t nb = 0;
+    for (size_t t = 0; t < rig->tissue_count; t++)
+        nb += rig->tissues[t].kind == POSE_TISSUE_BONE && rig->tissues[t].joint >= 0 &&
+              rig->tissues[t].triangle_count > 0;
+    p->bones = pose__calloc(&p->allocator, (nb + 1) * sizeof *p->bones, POSE__ALIGN);
+    p->frames = pose__alloc(&p->allocator, (nb + 1) * 12 * sizeof(float), POSE__ALIGN);
+    p->bone_spheres = pose__alloc(&p->allocator, (nb + 1) * 4 * sizeof(float), POSE__ALIGN);
+    if (!p->bones || !p->frames || !p->bone_spheres)
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu bones", nb);
+    pose_status s = POSE_OK;
+    for (size_t t = 0; t < rig->tissue_count && s == POSE_OK; t++) {
+        const pose__tissue *ts = &rig->tissues[t];
+        if (ts->kind != POSE_TISSUE_BONE || ts->joint < 0 || ts->triangle_count == 0)
+            continue;
+        pose__push_bone *b = &p->bones[p->bone_count++];
+        b->joint = ts->joint;
+        b->rest = ts->positions;
+        s = pose__bvh_build(&b->tree, &p->allocator, ts->triangles, (uint32_t)ts->triangle_count, ts->positions);
+        if (s == POSE_OK)
+            s = pseudo_normals(b, ts, &p->allocator);
+        if (s == POSE_OK)
+            s = bone_grid(b, ts, margin, &p->allocator);
+    }
+    if (s == POSE_OK)
+        s = skin_order(p, st);
+    if (s != POSE_OK)
+        return s;
+    mark_rest_inside(p, st);
+    p->build_seconds = pose__seconds() - t0;
+    return POSE_OK;
+}
