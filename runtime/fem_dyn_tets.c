@@ -48,14 +48,13 @@ void pose__fem_dyn_rotate(const pose__fem_dyn_tets *tets, pose__fem_dyn_rot *rot
 }
 
 void pose__fem_dyn_product(const pose__fem_dyn_tets *tets, const pose__fem_dyn_rot *rot,
-                           const float *z, const float *p, const float *beta,
-                           const uint32_t *island, float *out, size_t b, size_t e)
+                           const float *u, float *out, float *energy, size_t b, size_t e)
 {
 #ifdef POSE__HAVE_AVX2_KERNELS
     if (pose__kernels_use_avx2()) {
-        pose__fem_dyn_product_avx2(tets, rot, z, p, beta, island, out, b, e);
+        pose__fem_dyn_product_avx2(tets, rot, u, out, energy, b, e);
         return;
     }
 #endif
-    pose__fem_dyn_product_generic(tets, rot, z, p, beta, island, out, b, e);
+    pose__fem_dyn_product_generic(tets, rot, u, out, energy, b, e);
 }

@@ -78,13 +78,11 @@ void pose__fem_dyn_rotate(const pose__fem_dyn_tets *tets, pose__fem_dyn_rot *rot
                           const float *v, int steps, float *f, float *kv, float *blk, size_t b,
                           size_t e);
 /**
- * Blocks [b, e): corner products K d, d = z + beta[island[t]] p per vertex,
- * with the last rotations, into out (12 rows). island: per tet, padded to
- * whole blocks.
+ * Blocks [b, e): corner products K u with the last rotations into out (12
+ * rows), and each tet's u^T K u into energy (one row of 8 per block).
  */
 void pose__fem_dyn_product(const pose__fem_dyn_tets *tets, const pose__fem_dyn_rot *rot,
-                           const float *z, const float *p, const float *beta,
-                           const uint32_t *island, float *out, size_t b, size_t e);
+                           const float *u, float *out, float *energy, size_t b, size_t e);
 
 /* The variants behind the two above. */
 #define POSE__FEM_DYN_VARIANT_DECL(sfx)                                                          \
@@ -92,9 +90,8 @@ void pose__fem_dyn_product(const pose__fem_dyn_tets *tets, const pose__fem_dyn_r
                                     const float *x, const float *v, int steps, float *f,         \
                                     float *kv, float *blk, size_t b, size_t e);                  \
     void pose__fem_dyn_product_##sfx(const pose__fem_dyn_tets *tets,                             \
-                                     const pose__fem_dyn_rot *rot, const float *z,               \
-                                     const float *p, const float *beta, const uint32_t *island,  \
-                                     float *out, size_t b, size_t e);
+                                     const pose__fem_dyn_rot *rot, const float *u, float *out,   \
+                                     float *energy, size_t b, size_t e);
 POSE__FEM_DYN_VARIANT_DECL(generic)
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 POSE__FEM_DYN_VARIANT_DECL(avx2)

@@ -40,7 +40,7 @@ static POSE__INLINE void unrotate8(const pose__v8f R[9], const pose__v8f G[9], p
  * corner i > 0 gets P g_i, corner 0 minus their sum; negated when neg (the
  * forces -V P g_i). Stored as 12 rows at out. */
 static POSE__INLINE void corners8(const pose__fem_dyn_tets *t, const pose__v8f R[9],
-                                  const pose__v8f H[9], int neg, float *out)
+                                  const pose__v8f H[9], int neg, float *out, pose__v8f *energy)
 {
     const pose__v8f vmu = LOAD8(t->vmu), lt = LOAD8(t->vlambda) * (H[0] + H[4] + H[8]);
     pose__v8f S[9];
@@ -54,6 +54,9 @@ static POSE__INLINE void corners8(const pose__fem_dyn_tets *t, const pose__v8f R
     for (int r = 0; r < 3; r++)
         for (int c = 0; c < 3; c++)
             P[3 * r + c] = R[3 * r] * S[c] + R[3 * r + 1] * S[3 + c] + R[3 * r + 2] * S[6 + c];
+    if (energy) /* u^T K u = P : G = S : H (H = R^T G; S symmetric) */
+        *energy = S[0] * H[0] + S[4] * H[4] + S[8] * H[8] + S[1] * (H[1] + H[3]) +
+                  S[2] * (H[2] + H[6]) + S[5] * (H[5] + H[7]);
     pose__v8f s0[3] = {V8_SPLAT(0.0f), V8_SPLAT(0.0f), V8_SPLAT(0.0f)};
     for (int i = 0; i < 3; i++) {
         const pose__v8f g0 = LOAD8(t->b[3 * i]), g1 = LOAD8(t->b[3 * i + 1]),
@@ -128,32 +131,29 @@ void POSE__KV(pose__fem_dyn_rotate)(const pose__fem_dyn_tets *tets, pose__fem_dy
         H[0] -= V8_SPLAT(1.0f);
         H[4] -= V8_SPLAT(1.0f);
         H[8] -= V8_SPLAT(1.0f);
-        corners8(t, R, H, 1, f + k * rows);
+        corners8(t, R, H, 1, f + k * rows, NULL);
         /* K v with the new rotations: the warm start's product */
         gather8(t, v, u);
         grad8(t, u, F);
         unrotate8(R, F, H);
-        corners8(t, R, H, 0, kv + k * rows);
+        corners8(t, R, H, 0, kv + k * rows, NULL);
         blocks8(t, R, blk + 2 * k * rows);
     }
 }
 
 void POSE__KV(pose__fem_dyn_product)(const pose__fem_dyn_tets *tets, const pose__fem_dyn_rot *rot,
-                                     const float *z, const float *p, const float *beta,
-                                     const uint32_t *island, float *out, size_t b, size_t e)
+                                     const float *u, float *out, float *energy, size_t b, size_t e)
 {
     for (size_t k = b; k < e; k++) {
         const pose__fem_dyn_tets *t = tets + k;
         const pose__fem_dyn_rot *ro = rot + k;
-        const pose__v8f vb = V8_GATHER(beta, island + k * POSE__FEM_LANES, 1, 0);
-        pose__v8f u[4][3], G[9], R[9], H[9];
-        for (int c = 0; c < 4; c++)
-            for (int a = 0; a < 3; a++)
-                u[c][a] = V8_GATHER(z, t->v[c], 3, a) + vb * V8_GATHER(p, t->v[c], 3, a);
-        grad8(t, u, G);
+        pose__v8f c[4][3], G[9], R[9], H[9], en;
+        gather8(t, u, c);
+        grad8(t, c, G);
         for (int i = 0; i < 9; i++)
             R[i] = LOAD8(ro->r[i]);
         unrotate8(R, G, H);
-        corners8(t, R, H, 0, out + k * 12 * POSE__FEM_LANES);
+        corners8(t, R, H, 0, out + k * 12 * POSE__FEM_LANES, &en);
+        STORE8(energy + k * POSE__FEM_LANES, en);
     }
 }

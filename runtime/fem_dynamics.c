@@ -107,7 +107,7 @@ void pose__fem_dyn_islands(const pose__fem_mesh *m, uint32_t *p, size_t *island_
 
 typedef struct layout {
     size_t island, tet_island, seg_offset, seg_first, seg_island, x, v, bone_prev, stiff, tets,
-        rot, f, kv, blk, seg_sum, isl, alpha, beta, size;
+        rot, f, kv, blk, corner, energy, group_sum, group_island, seg_sum, isl, alpha, beta, size;
 } layout;
 
 static layout layout_of(const pose__fem_mesh *m, size_t islands, size_t segs)
@@ -131,7 +131,11 @@ static layout layout_of(const pose__fem_mesh *m, size_t islands, size_t segs)
     TAKE(f, nb * rows);
     TAKE(kv, nb * rows);
     TAKE(blk, 2 * nb * rows);
-    TAKE(seg_sum, 3 * segs * sizeof(double));
+    TAKE(corner, m->corner_offset[nv] * sizeof(uint32_t));
+    TAKE(energy, nb * POSE__FEM_LANES * sizeof(float));
+    TAKE(group_sum, pose__fem_dyn_groups(m) * sizeof(double));
+    TAKE(group_island, pose__fem_dyn_groups(m) * sizeof(uint32_t));
+    TAKE(seg_sum, POSE__FEM_SUMS * segs * sizeof(double));
     TAKE(isl, ni * sizeof(pose__fem_island));
     TAKE(alpha, ni * sizeof(float));
     TAKE(beta, ni * sizeof(float));
@@ -168,6 +172,10 @@ void pose__fem_dyn_init(const pose__fem_mesh *m, const uint32_t *island, size_t 
         .f = (float *)(b + l.f),
         .kv = (float *)(b + l.kv),
         .blk = (float *)(b + l.blk),
+        .corner = (uint32_t *)(b + l.corner),
+        .energy = (float *)(b + l.energy),
+        .group_sum = (double *)(b + l.group_sum),
+        .group_island = (uint32_t *)(b + l.group_island),
         .seg_sum = (double *)(b + l.seg_sum),
         .isl = (pose__fem_island *)(b + l.isl),
         .alpha = (float *)(b + l.alpha),
@@ -175,9 +183,20 @@ void pose__fem_dyn_init(const pose__fem_mesh *m, const uint32_t *island, size_t 
     };
     memcpy(d->island, island, m->vertex_count * sizeof(uint32_t));
     pose__fem_dyn_tets_build(m, d->tets, d->rot);
+    for (size_t k = 0; k < m->corner_offset[m->vertex_count]; k++)
+        d->corner[k] = (uint32_t)pose__fem_dyn_corner(m->corners[k], 12);
     for (size_t t = 0; t < m->tet_count; t++) {
         const uint32_t i = island[m->tets[t].v[0]];
         d->tet_island[t] = i == POSE__FEM_KINEMATIC ? 0 : i; /* massless: never stepped */
+    }
+    for (size_t g = 0; g < pose__fem_dyn_groups(m); g++) {
+        const size_t b0 = g * POSE__FEM_GROUP * POSE__FEM_LANES;
+        size_t e0 = b0 + POSE__FEM_GROUP * POSE__FEM_LANES;
+        e0 = e0 < m->tet_count ? e0 : m->tet_count;
+        d->group_island[g] = d->tet_island[b0];
+        for (size_t t = b0; t < e0; t++)
+            if (d->tet_island[t] != d->group_island[g])
+                d->group_island[g] = POSE__FEM_KINEMATIC; /* mixed */
     }
     size_t n = 0;
     for (size_t k = 0; k < m->chunk_count; k++) {
@@ -214,7 +233,7 @@ void pose__fem_dyn_reset(const pose__fem_mesh *m, pose__fem_dyn *d, const float 
 
 /* ------------------------------------------------------------ passes */
 
-enum { PASS_ROTATE, PASS_RESIDUAL, PASS_PRODUCT, PASS_GATHER, PASS_UPDATE, PASS_INTEGRATE };
+enum { PASS_ROTATE, PASS_RESIDUAL, PASS_PRODUCT, PASS_UPDATE, PASS_INTEGRATE };
 
 typedef struct step_ctx {
     const pose__fem_mesh *mesh;
@@ -229,28 +248,42 @@ typedef struct step_ctx {
 } step_ctx;
 
 /* Sum of vertex v's corner values in a 12-row output (fem_dyn_tets.h), in
- * the mesh's fixed corner order. */
-static inline void gather(const pose__fem_mesh *m, const float *rows, size_t v, float out[3])
+ * the mesh's fixed corner order: even and odd corners apart, then added
+ * (two chains of dependent adds instead of one: the vertex passes wait on
+ * them, not on the loads). */
+static inline void gather(const pose__fem_mesh *m, const uint32_t *off, const float *rows,
+                          size_t v, float out[3])
 {
-    float s[3] = {0, 0, 0};
-    for (uint32_t k = m->corner_offset[v]; k < m->corner_offset[v + 1]; k++) {
-        const float *f = rows + pose__fem_dyn_corner(m->corners[k], 12);
-        s[0] += f[0];
-        s[1] += f[POSE__FEM_LANES];
-        s[2] += f[2 * POSE__FEM_LANES];
+    float s[2][3] = {{0, 0, 0}, {0, 0, 0}};
+    uint32_t k = m->corner_offset[v];
+    const uint32_t e = m->corner_offset[v + 1];
+    for (; k + 1 < e; k += 2)
+        for (int h = 0; h < 2; h++) {
+            const float *f = rows + off[k + (uint32_t)h];
+            s[h][0] += f[0];
+            s[h][1] += f[POSE__FEM_LANES];
+            s[h][2] += f[2 * POSE__FEM_LANES];
+        }
+    if (k < e) {
+        const float *f = rows + off[k];
+        s[0][0] += f[0];
+        s[0][1] += f[POSE__FEM_LANES];
+        s[0][2] += f[2 * POSE__FEM_LANES];
     }
-    out[0] = s[0];
-    out[1] = s[1];
-    out[2] = s[2];
+    out[0] = s[0][0] + s[1][0];
+    out[1] = s[0][1] + s[1][1];
+    out[2] = s[0][2] + s[1][2];
 }
 
-/* Vertex v's 3x3 stiffness block (xx xy xz yy yz zz) from the corners'. */
-static inline void vertex_block(const pose__fem_mesh *m, const float *blk, size_t v, double k[6])
+/* Vertex v's 3x3 stiffness block (xx xy xz yy yz zz) from the corners'
+ * (corner k's 24-row offset from its 12-row one: same block and lane). */
+static inline void vertex_block(const pose__fem_mesh *m, const uint32_t *off, const float *blk,
+                                size_t v, double k[6])
 {
     for (int e = 0; e < 6; e++)
         k[e] = 0.0;
     for (uint32_t i = m->corner_offset[v]; i < m->corner_offset[v + 1]; i++) {
-        const float *b = blk + pose__fem_dyn_corner(m->corners[i], 24);
+        const float *b = blk + 2 * (size_t)off[i] - (off[i] & (POSE__FEM_LANES - 1));
         for (int e = 0; e < 6; e++)
             k[e] += b[e * POSE__FEM_LANES];
     }
@@ -263,100 +296,107 @@ static inline float spring_of(const step_ctx *c, size_t v)
     return c->mesh->inv_diag[v] == 0.0f ? c->prm->coupling * c->d->stiff[v] : 0.0f;
 }
 
-/* The volume term's product scale of island i: kscale kappa_g (g . p). */
-static inline float vol_product(const step_ctx *c, uint32_t i)
-{
-    return (float)(c->kscale * c->mesh->surface.stiffness * c->d->isl[i].gp);
-}
-
-static void segment_pass(step_ctx *c, size_t s, size_t e)
+/* The warm start's residual r = b - A v, b = M v + dt f, with f every
+ * force at x but the damping (the spring pulls toward the bone where it is
+ * at the end of the step, its damping acts on the velocity relative to the
+ * bone's); the preconditioner P (inverse blocks of A); u = P r; p = s = 0.
+ * Sums: r.u, r.r, b^T P b, u.(D u), g.u. */
+static void residual_vertex(const step_ctx *c, size_t v, float vp, double sum[POSE__FEM_SUMS])
 {
     const pose__fem_mesh *m = c->mesh;
     pose__fem_work *w = c->w;
-    pose__fem_dyn *d = c->d;
+    const pose__fem_dyn *d = c->d;
     const pose__fem_dyn_params *prm = c->prm;
+    const float dt = prm->dt, mass = m->mass[v], ks = spring_of(c, v);
+    float *r = w->r + 3 * v, *u = w->z + 3 * v, *pre = w->pre + 6 * v;
+    const float *vel = d->v + 3 * v, *gv = w->gvol + 3 * v, *x = d->x + 3 * v;
+    const float *bo = c->bones + 3 * v, *bp = d->bone_prev + 3 * v;
+    float f[3], kv[3], bv[3], pb[3];
+    gather(m, d->corner, d->f, v, f);
+    gather(m, d->corner, d->kv, v, kv);
+    for (int a = 0; a < 3; a++) {
+        const float fa = f[a] + c->vol_force * gv[a] + mass * prm->gravity[a] + ks * (bo[a] - x[a]) +
+                         prm->beta * ks * (bo[a] - bp[a]) / dt;
+        bv[a] = mass * vel[a] + dt * fa;
+        r[a] = dt * fa - (c->mscale - 1.0f) * mass * vel[a] - c->kscale * (kv[a] + ks * vel[a]) -
+               vp * gv[a];
+        w->p[3 * v + a] = w->ap[3 * v + a] = 0.0f;
+    }
+    double k[6];
+    vertex_block(m, d->corner, d->blk, v, k);
+    for (int e6 = 0; e6 < 6; e6++)
+        k[e6] *= c->kscale;
+    const double diag = (double)c->mscale * mass + (double)c->kscale * ks;
+    k[0] += diag;
+    k[3] += diag;
+    k[5] += diag;
+    if (pose__fem_invert_block(k, pre) < 0) {
+        pre[0] = pre[3] = pre[5] = (float)(1.0 / diag);
+        pre[1] = pre[2] = pre[4] = 0.0f;
+    }
+    pose__fem_apply_block(pre, bv, pb);
+    pose__fem_apply_block(pre, r, u);
+    const float dd = c->mscale * mass + c->kscale * ks;
+    for (int a = 0; a < 3; a++) {
+        sum[0] += (double)r[a] * u[a];
+        sum[1] += (double)r[a] * r[a];
+        sum[2] += (double)bv[a] * pb[a];
+        sum[3] += (double)u[a] * (dd * u[a]);
+        sum[4] += (double)gv[a] * u[a];
+    }
+}
+
+/* One Chronopoulos-Gear CG iteration at a vertex: w = A u (the gathered
+ * K u, the diagonal D = mscale M + kscale K_s, the volume term's rank one
+ * vp g), p = u + beta p, s = w + beta s (= A p), v += alpha p,
+ * r -= alpha s, u = P r. Sums: r.u, r.r, -, u.(D u), g.u. */
+static void update_vertex(const step_ctx *c, size_t v, float alpha, float beta, float vp,
+                          double sum[POSE__FEM_SUMS])
+{
+    const pose__fem_mesh *m = c->mesh;
+    pose__fem_work *w = c->w;
+    const float mass = m->mass[v], ks = spring_of(c, v), dd = c->mscale * mass + c->kscale * ks;
+    float *r = w->r + 3 * v, *u = w->z + 3 * v, *p = w->p + 3 * v, *sv = w->ap + 3 * v;
+    float *vel = c->d->v + 3 * v;
+    const float *gv = w->gvol + 3 * v;
+    float f[3];
+    gather(m, c->d->corner, c->d->f, v, f);
+    for (int a = 0; a < 3; a++) {
+        const float wa = c->mscale * mass * u[a] + c->kscale * (f[a] + ks * u[a]) + vp * gv[a];
+        p[a] = u[a] + beta * p[a];
+        sv[a] = wa + beta * sv[a];
+        vel[a] += alpha * p[a];
+        r[a] -= alpha * sv[a];
+    }
+    pose__fem_apply_block(w->pre + 6 * v, r, u);
+    for (int a = 0; a < 3; a++) {
+        sum[0] += (double)r[a] * u[a];
+        sum[1] += (double)r[a] * r[a];
+        sum[3] += (double)u[a] * (dd * u[a]);
+        sum[4] += (double)gv[a] * u[a];
+    }
+}
+
+/* A vertex pass over segment s (vertices [seg_first[s], e) of its island). */
+static void segment_pass(step_ctx *c, size_t s, size_t e)
+{
+    pose__fem_dyn *d = c->d;
     const uint32_t i = d->seg_island[s];
     const pose__fem_island *is = &d->isl[i];
-    const float dt = prm->dt, alpha = d->alpha[i], beta = d->beta[i];
-    const float vp = vol_product(c, i);
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-    if (c->pass != PASS_RESIDUAL && !is->active)
-        goto done;
-    for (size_t v = d->seg_first[s]; v < e; v++) {
-        if (d->island[v] != i)
-            continue;
-        const float mass = m->mass[v], ks = spring_of(c, v);
-        float *r = w->r + 3 * v, *z = w->z + 3 * v, *p = w->p + 3 * v, *ap = w->ap + 3 * v;
-        float *vel = d->v + 3 * v, *pre = w->pre + 6 * v;
-        const float *gv = w->gvol + 3 * v, *x = d->x + 3 * v;
-        float f[3];
-        switch (c->pass) {
-        case PASS_RESIDUAL: {
-            /* r = b - A v, b = M v + dt f: the warm start's residual, with
-             * f every force at x but the damping; the spring pulls toward
-             * the bone where it is at the end of the step, its damping acts
-             * on the velocity relative to the bone's */
-            const float *bo = c->bones + 3 * v, *bp = d->bone_prev + 3 * v;
-            float kv[3], bv[3], pb[3];
-            gather(m, d->f, v, f);
-            gather(m, d->kv, v, kv);
-            for (int a = 0; a < 3; a++) {
-                const float fa = f[a] + c->vol_force * gv[a] + mass * prm->gravity[a] +
-                                 ks * (bo[a] - x[a]) + prm->beta * ks * (bo[a] - bp[a]) / dt;
-                bv[a] = mass * vel[a] + dt * fa;
-                r[a] = dt * fa - (c->mscale - 1.0f) * mass * vel[a] -
-                       c->kscale * (kv[a] + ks * vel[a]) - vp * gv[a];
-                p[a] = 0.0f;
-            }
-            double k[6];
-            vertex_block(m, d->blk, v, k);
-            for (int e6 = 0; e6 < 6; e6++)
-                k[e6] *= c->kscale;
-            const double diag = (double)c->mscale * mass + (double)c->kscale * ks;
-            k[0] += diag;
-            k[3] += diag;
-            k[5] += diag;
-            if (pose__fem_invert_block(k, pre) < 0) {
-                pre[0] = pre[3] = pre[5] = (float)(1.0 / diag);
-                pre[1] = pre[2] = pre[4] = 0.0f;
-            }
-            pose__fem_apply_block(pre, bv, pb);
-            s2 += (double)bv[0] * pb[0] + (double)bv[1] * pb[1] + (double)bv[2] * pb[2];
-            pose__fem_apply_block(pre, r, z);
-            for (int a = 0; a < 3; a++) {
-                s0 += (double)r[a] * z[a];
-                s1 += (double)r[a] * r[a];
-            }
-            break;
+    const float alpha = d->alpha[i], beta = d->beta[i];
+    /* the volume term's product scale: kscale kappa_g (g . u) */
+    const float vp = (float)(c->kscale * c->mesh->surface.stiffness * is->gu);
+    double sum[POSE__FEM_SUMS] = {0};
+    if (c->pass == PASS_RESIDUAL || is->active)
+        for (size_t v = d->seg_first[s]; v < e; v++) {
+            if (d->island[v] != i)
+                continue;
+            if (c->pass == PASS_RESIDUAL)
+                residual_vertex(c, v, vp, sum);
+            else
+                update_vertex(c, v, alpha, beta, vp, sum);
         }
-        case PASS_GATHER:
-            gather(m, d->f, v, f);
-            for (int a = 0; a < 3; a++) {
-                p[a] = z[a] + beta * p[a];
-                ap[a] = c->mscale * mass * p[a] + c->kscale * (f[a] + ks * p[a]);
-                s0 += (double)p[a] * ap[a];
-                s2 += (double)p[a] * gv[a];
-            }
-            break;
-        case PASS_UPDATE:
-            for (int a = 0; a < 3; a++) {
-                vel[a] += alpha * p[a];
-                r[a] -= alpha * (ap[a] + vp * gv[a]);
-            }
-            pose__fem_apply_block(pre, r, z);
-            for (int a = 0; a < 3; a++) {
-                s0 += (double)r[a] * z[a];
-                s1 += (double)r[a] * r[a];
-            }
-            break;
-        default:
-            break;
-        }
-    }
-done:
-    d->seg_sum[3 * s] = s0;
-    d->seg_sum[3 * s + 1] = s1;
-    d->seg_sum[3 * s + 2] = s2;
+    memcpy(d->seg_sum + POSE__FEM_SUMS * s, sum, sizeof sum);
 }
 
 /* x += dt v for the simulated vertices; the others move with their bone.
@@ -391,6 +431,21 @@ static void integrate_chunk(step_ctx *c, size_t k)
     c->w->partial[4 * k] = ke;
 }
 
+/* K u for group g's tets, and when they are one island's, the sum of
+ * their u^T K u in tet order. */
+static void product_group(const pose__fem_mesh *m, pose__fem_work *w, pose__fem_dyn *d, size_t g)
+{
+    const size_t nb = pose__fem_dyn_blocks(m), b = g * POSE__FEM_GROUP;
+    const size_t e = b + POSE__FEM_GROUP < nb ? b + POSE__FEM_GROUP : nb;
+    pose__fem_dyn_product(d->tets, d->rot, w->z, d->f, d->energy, b, e);
+    if (d->group_island[g] == POSE__FEM_KINEMATIC)
+        return;
+    double sum = 0.0;
+    for (size_t t = b * POSE__FEM_LANES; t < e * POSE__FEM_LANES; t++)
+        sum += d->energy[t]; /* padding lanes add +0 */
+    d->group_sum[g] = sum;
+}
+
 /* Most rotation extraction steps per tet and step (fem_solve.c's count:
  * warm-started, most tets converge in a few; the rest go on next step). */
 #define FEM_POLAR_STEPS 8
@@ -401,14 +456,16 @@ static void pass_task(void *ctx, unsigned part, unsigned parts)
     const pose__fem_mesh *m = c->mesh;
     pose__fem_work *w = c->w;
     pose__fem_dyn *d = c->d;
-    if (c->pass == PASS_ROTATE || c->pass == PASS_PRODUCT) {
+    if (c->pass == PASS_ROTATE) { /* with K v: the warm start's product */
         const size_t nb = pose__fem_dyn_blocks(m);
         const size_t b = pose__part_begin(nb, part, parts), e = pose__part_begin(nb, part + 1, parts);
-        if (c->pass == PASS_ROTATE) /* with K v: the warm start's product */
-            pose__fem_dyn_rotate(d->tets, d->rot, d->x, d->v, FEM_POLAR_STEPS, d->f, d->kv, d->blk,
-                                 b, e);
-        else
-            pose__fem_dyn_product(d->tets, d->rot, w->z, w->p, d->beta, d->tet_island, d->f, b, e);
+        pose__fem_dyn_rotate(d->tets, d->rot, d->x, d->v, FEM_POLAR_STEPS, d->f, d->kv, d->blk, b, e);
+        return;
+    }
+    if (c->pass == PASS_PRODUCT) {
+        const size_t ng = pose__fem_dyn_groups(m);
+        for (size_t g = pose__part_begin(ng, part, parts); g < pose__part_begin(ng, part + 1, parts); g++)
+            product_group(m, w, d, g);
         return;
     }
     const size_t kb = pose__part_begin(m->chunk_count, part, parts);
@@ -439,15 +496,30 @@ static void run(step_ctx *c, pose__pool *pool, int pass)
         pose__pool_run(pool, pass_task, c);
     else
         pass_task(c, 0, 1);
-    if (pass != PASS_RESIDUAL && pass != PASS_GATHER && pass != PASS_UPDATE)
-        return;
     pose__fem_dyn *d = c->d;
+    if (pass == PASS_PRODUCT) { /* the tets' u^T K u per island, group after group */
+        for (size_t i = 0; i < d->island_count; i++)
+            d->isl[i].tet = 0.0;
+        for (size_t g = 0; g < pose__fem_dyn_groups(c->mesh); g++) {
+            if (d->group_island[g] != POSE__FEM_KINEMATIC) {
+                d->isl[d->group_island[g]].tet += d->group_sum[g];
+                continue;
+            }
+            const size_t b = g * POSE__FEM_GROUP * POSE__FEM_LANES;
+            const size_t e = b + POSE__FEM_GROUP * POSE__FEM_LANES;
+            for (size_t t = b; t < e && t < c->mesh->tet_count; t++)
+                d->isl[d->tet_island[t]].tet += d->energy[t];
+        }
+        return;
+    }
+    if (pass != PASS_RESIDUAL && pass != PASS_UPDATE)
+        return;
     for (size_t i = 0; i < d->island_count; i++)
         memset(d->isl[i].sum, 0, sizeof d->isl[i].sum);
     for (size_t s = 0; s < d->segment_count; s++) {
         double *sum = d->isl[d->seg_island[s]].sum;
-        for (int k = 0; k < 3; k++)
-            sum[k] += d->seg_sum[3 * s + k];
+        for (int k = 0; k < POSE__FEM_SUMS; k++)
+            sum[k] += d->seg_sum[POSE__FEM_SUMS * s + k];
     }
 }
 
@@ -467,10 +539,11 @@ void pose__fem_dyn_step(const pose__fem_mesh *m, pose__fem_work *w, pose__fem_dy
                   .kscale = (float)(dt * prm->beta + dt * dt)};
     const double t0 = now();
     const size_t ni = d->island_count;
+    const double kg = c.kscale * m->surface.stiffness; /* the volume term's product factor */
     for (size_t i = 0; i < (ni > 0 ? ni : 1); i++)
         d->beta[i] = d->alpha[i] = 0.0f;
     for (size_t i = 0; i < ni; i++) {
-        d->isl[i].gp = 0.0;
+        d->isl[i].gu = 0.0;
         d->isl[i].active = 0;
         d->isl[i].iterations = 0;
     }
@@ -483,7 +556,7 @@ void pose__fem_dyn_step(const pose__fem_mesh *m, pose__fem_work *w, pose__fem_dy
         for (size_t v = 0; v < m->vertex_count; v++) {
             const float *g = w->gvol + 3 * v, *vel = d->v + 3 * v;
             if (d->island[v] != POSE__FEM_KINEMATIC)
-                d->isl[d->island[v]].gp += (double)g[0] * vel[0] + (double)g[1] * vel[1] +
+                d->isl[d->island[v]].gu += (double)g[0] * vel[0] + (double)g[1] * vel[1] +
                                            (double)g[2] * vel[2];
         }
     run(&c, pool, PASS_RESIDUAL);
@@ -494,6 +567,8 @@ void pose__fem_dyn_step(const pose__fem_mesh *m, pose__fem_work *w, pose__fem_dy
         is->rz = is->sum[0];
         is->rr = is->sum[1];
         is->bb = is->sum[2];
+        is->dm = is->sum[3];
+        is->gu = is->sum[4];
         /* In the preconditioner's norm (P about A^-1: r^T P r measures
          * the velocity error by its energy, b^T P b about twice the kinetic
          * energy of the momentum b), relative to b's, but never below the
@@ -507,21 +582,25 @@ void pose__fem_dyn_step(const pose__fem_mesh *m, pose__fem_work *w, pose__fem_dy
     const double t1 = now();
     st.seconds_assembly = t1 - t0;
 
-    /* CG per island: one pass serves every island still iterating. */
+    /* CG per island, Chronopoulos-Gear's form: one product A u per
+     * iteration (u = P r), whose u^T A u the tets sum as they form it, so
+     * the step length is known before the one vertex pass that updates
+     * p, A p, v, r and u (two passes and one reduction per iteration
+     * where plain CG takes three and two). */
     for (int it = 0; it < prm->cg_iterations && any; it++) {
         run(&c, pool, PASS_PRODUCT);
-        run(&c, pool, PASS_GATHER);
         for (size_t i = 0; i < ni; i++) {
             pose__fem_island *is = &d->isl[i];
             if (!is->active)
                 continue;
-            is->gp = is->sum[2];
-            const double pap = is->sum[0] + c.kscale * m->surface.stiffness * is->gp * is->gp;
-            if (!(pap > 0.0)) {
+            const double uau = c.kscale * is->tet + is->dm + kg * is->gu * is->gu;
+            const double den = is->iterations == 0 ? uau : uau - d->beta[i] * is->rz / is->alpha;
+            if (!(den > 0.0)) {
                 is->active = 0;
                 continue;
             }
-            d->alpha[i] = (float)(is->rz / pap);
+            is->alpha = is->rz / den;
+            d->alpha[i] = (float)is->alpha;
         }
         run(&c, pool, PASS_UPDATE);
         any = 0;
@@ -531,6 +610,8 @@ void pose__fem_dyn_step(const pose__fem_mesh *m, pose__fem_work *w, pose__fem_dy
                 continue;
             const double rz = is->sum[0];
             is->rr = is->sum[1];
+            is->dm = is->sum[3];
+            is->gu = is->sum[4];
             is->iterations++;
             d->beta[i] = (float)(rz / is->rz);
             is->rz = rz;
@@ -567,9 +648,11 @@ double pose__fem_dyn_bytes(const pose__fem_mesh *m, double cg_iterations)
      * (~112 each) and the integration (80) */
     const double assembly = nt * (60.0 + 32.0 + 36.0 + 96.0 + 192.0 + 4.0 * 52.0) +
                             nv * (112.0 + 112.0 + 80.0);
-    /* per iteration: product (block constants 60, rotation 36, z and p at
-     * 4 corners 96, products 48, island 4), the gather of its corners
-     * (4 x 16), and the gather (76) and update (124) passes per vertex */
-    const double iteration = nt * (244.0 + 64.0) + nv * (76.0 + 124.0);
+    /* per iteration: product (block constants 60, rotation 36, u at 4
+     * corners 48, products 48, energy 4), the gather of its corners
+     * (4 x (offset 4 + 12)), and the one vertex pass (reads u p s v r 60,
+     * preconditioner 24, volume gradient 12, mass, weight, stiffness,
+     * island and corner range 20; writes u p s v r 60) */
+    const double iteration = nt * (196.0 + 64.0) + nv * 176.0;
     return assembly + cg_iterations * iteration;
 }

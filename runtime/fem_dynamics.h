@@ -19,9 +19,12 @@
  * soft tissue (tets sharing vertices; the skin's volume term joins every
  * vertex it touches). Each island runs its own block-Jacobi preconditioned
  * CG (its own step lengths and stopping test), warm-started from the last
- * velocities. Reductions are summed per segment (a run of one island's
- * vertices inside a POSE__FEM_CHUNK) and then segment after segment, so the
- * result is the same for any thread count. Steps allocate nothing. */
+ * velocities, in Chronopoulos and Gear's form (one product, one vertex
+ * pass and one reduction per iteration). Reductions are summed per segment
+ * (a run of one island's vertices inside a POSE__FEM_CHUNK) and then
+ * segment after segment, the tets' u^T K u per group of POSE__FEM_GROUP
+ * blocks and then group after group, so the result is the same for any
+ * thread count. Steps allocate nothing. */
 #ifndef POSE_FEM_DYNAMICS_H
 #define POSE_FEM_DYNAMICS_H
 
@@ -54,14 +57,23 @@ typedef struct pose__fem_dyn_stats {
     double seconds_cg;          /**< CG iterations */
 } pose__fem_dyn_stats;
 
-/** One coupling island's CG scalars. */
+/** Sums a vertex pass forms per segment. */
+#define POSE__FEM_SUMS 5
+/** Blocks of tets whose u^T K u a product pass sums together (one part
+ *  takes whole groups, so the sums do not depend on the thread count). */
+#define POSE__FEM_GROUP 16u
+
+/** One coupling island's CG scalars (u = P r: the preconditioned residual). */
 typedef struct pose__fem_island {
-    double sum[3];          /**< the last vertex pass's sums over the island */
-    double rz, rr;          /**< r . z and r . r */
+    double sum[POSE__FEM_SUMS]; /**< the last vertex pass's sums over the island */
+    double rz, rr;          /**< r . u and r . r */
     double bb;              /**< b^T P b (P: the block-Jacobi preconditioner) */
     double mm;              /**< 3 sum(m) (1e-2)^2: twice its kinetic energy at 1e-2 units/s */
     double stop;            /**< tolerance^2 max(b^T P b, mm) */
-    double gp;              /**< the volume gradient . the last product's input */
+    double dm;              /**< u^T D u, D = (1 + dt alpha) M + kscale K_s: A's diagonal part */
+    double gu;              /**< the volume gradient . u (. v before the residual pass) */
+    double tet;             /**< the tets' u^T K u, summed by the last product pass */
+    double alpha;           /**< the last step length */
     int iterations;
     int active;             /**< still iterating */
 } pose__fem_island;
@@ -85,10 +97,21 @@ typedef struct pose__fem_dyn {
     float *f;               /**< per block, 12 rows: elastic forces, then the CG's products */
     float *kv;              /**< per block, 12 rows: K v of the rotate pass */
     float *blk;             /**< per block, 24 rows: the corners' stiffness blocks */
-    double *seg_sum;        /**< 3 per segment */
+    uint32_t *corner;       /**< per mesh corner entry (mesh->corners' order): its offset
+                                 in a 12-row output (pose__fem_dyn_corner) */
+    float *energy;          /**< per tet (whole blocks): u^T K u of the last product */
+    double *group_sum;      /**< per group of POSE__FEM_GROUP blocks: the sum of its energies */
+    uint32_t *group_island; /**< per group: its tets' island, or POSE__FEM_KINEMATIC if mixed */
+    double *seg_sum;        /**< POSE__FEM_SUMS per segment */
     pose__fem_island *isl;  /**< island_count */
     float *alpha, *beta;    /**< per island (at least one): step length, direction update */
 } pose__fem_dyn;
+
+/** Groups of POSE__FEM_GROUP tet blocks. */
+static inline size_t pose__fem_dyn_groups(const pose__fem_mesh *m)
+{
+    return (pose__fem_dyn_blocks(m) + POSE__FEM_GROUP - 1) / POSE__FEM_GROUP;
+}
 
 /**
  * Coupling islands of the mesh into `island` (per vertex, numbered in
