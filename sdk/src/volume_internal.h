@@ -21,6 +21,24 @@ typedef struct pose__vol_box {
     int32_t i0, i1, j0, j1, k0, k1;
 } pose__vol_box;
 
+/* Voxels staged for sampling (one per slab part, at most
+ * POSE__VOL_STAGE + POSE__VOL_STAGE_SLACK): the output voxel and its
+ * preimage in the rest image's index space, whose trilinear cell lies in
+ * the image (a tet's rest vertices all do: POSE__VOL_REST_INSIDE). Rows are
+ * short (two voxels on average on the bundled CT), so the rasterizer queues
+ * them and the gather samples them in batches, eight at a time where the
+ * CPU has AVX2. The slack lets a short run be queued with fixed-width
+ * stores. */
+#define POSE__VOL_STAGE 512
+#define POSE__VOL_STAGE_SLACK 8
+typedef struct pose__vol_stage {
+    uint32_t at[POSE__VOL_STAGE + POSE__VOL_STAGE_SLACK];
+    float x[POSE__VOL_STAGE + POSE__VOL_STAGE_SLACK];
+    float y[POSE__VOL_STAGE + POSE__VOL_STAGE_SLACK];
+    float z[POSE__VOL_STAGE + POSE__VOL_STAGE_SLACK];
+    unsigned n;
+} pose__vol_stage;
+
 struct pose_volume_sampler {
     const pose_rig *rig;
     pose_allocator allocator;
@@ -41,6 +59,8 @@ struct pose_volume_sampler {
     uint64_t *covered;
     size_t cover_words;
     pose__pool *pool;
+    pose__vol_stage *stages; /* one per part */
+    int use_avx2;            /* the variant, chosen at creation */
     /* the call in flight */
     const float *posed;
     float *dst_intensity;
@@ -59,13 +79,37 @@ struct pose_volume_sampler {
  *  space) in an image of grid g. */
 int pose__volume_rest_flags(const pose_volume_grid *g, const float *r[4]);
 
+
 /** Rasterize posed tet `t` (its box `box`) into output planes k0..k1 (one
  *  slab's share of the box): its covered voxels get the rest image sampled
- *  through the tet's inverse map and their covered bits. The values a voxel
- *  gets depend on the tet and the voxel only, never on k0/k1, so any slab
- *  split gives the same bytes. */
-void pose__volume_raster_tet(const pose_volume_sampler *s, size_t t, const pose__vol_box *box,
-                             int k0, int k1);
+ *  through the tet's inverse map (queued in `st` when the tet lies inside
+ *  the image) and their covered bits. The values a voxel gets depend on
+ *  the tet and the voxel only, never on k0/k1 or the queue, so any slab
+ *  split gives the same bytes. Two variants (volume_raster_body.h), the
+ *  same bytes. */
+void pose__volume_raster_tet_generic(const pose_volume_sampler *s, size_t t,
+                                     const pose__vol_box *box, int k0, int k1,
+                                     pose__vol_stage *st);
+
+/** Samples the queued voxels into the call's outputs and empties the queue
+ *  (volume_gather.c). */
+void pose__volume_gather(const pose_volume_sampler *s, pose__vol_stage *st);
+void pose__volume_gather_generic(const pose_volume_desc *rest, const pose__vol_stage *st,
+                                 unsigned begin, float *oi, uint16_t *ol);
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+/* Variants compiled with -mavx2, used when the CPU has it (and
+ * POSE_KERNELS=generic does not say otherwise, as for the skinning
+ * kernels). */
+#  define POSE__HAVE_AVX2_VOLUME 1
+void pose__volume_raster_tet_avx2(const pose_volume_sampler *s, size_t t,
+                                  const pose__vol_box *box, int k0, int k1,
+                                  pose__vol_stage *st);
+/** Queue entries [0, n - n % 8) eight at a time, when both outputs are
+ *  asked for; returns how many it sampled. */
+unsigned pose__volume_gather_avx2(const pose_volume_desc *rest, const pose__vol_stage *st,
+                                  float *oi, uint16_t *ol);
+#endif
 
 /** The covered bits of output row (j, k). */
 static inline uint64_t *pose__vol_cover_row(const pose_volume_sampler *s, size_t j, size_t k)

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "error.h"
+#include "rt_kernels.h"
 #include "rt_thread.h"
 #include "volume_internal.h"
 
@@ -132,8 +133,10 @@ pose_status pose_volume_sampler_create(const pose_rig *rig, const pose_volume_de
     s->tet_flags = pose__alloc(&a, ti.tet_count ? ti.tet_count : 1, POSE__ALIGN);
     s->cover_words = (og->nx + 63) / 64;
     s->covered = pose__alloc(&a, s->cover_words * og->ny * og->nz * sizeof *s->covered, POSE__ALIGN);
+    s->stages = pose__alloc(&a, n * sizeof *s->stages, POSE__ALIGN);
+    s->use_avx2 = pose__kernels_use_avx2();
     if (!s->rest_index || !s->posed_index || !s->pool || !s->boxes || !s->tet_flags ||
-        !s->covered) {
+        !s->covered || !s->stages) {
         pose__free(&a, s->pool);
         s->pool = NULL;
         pose_volume_sampler_free(s);
@@ -175,6 +178,7 @@ void pose_volume_sampler_free(pose_volume_sampler *s)
     pose__free(&a, s->boxes);
     pose__free(&a, s->tet_flags);
     pose__free(&a, s->covered);
+    pose__free(&a, s->stages);
     pose__free(&a, s);
 }
 
@@ -284,12 +288,20 @@ static void slab_task(void *ctx, unsigned part, unsigned parts)
     const size_t plane = s->cover_words * s->out.ny;
     memset(pose__vol_cover_row(s, 0, (size_t)z0), 0, (size_t)(z1 - z0 + 1) * plane * sizeof(uint64_t));
     const pose__vol_box *bx = s->boxes;
+    pose__vol_stage *st = &s->stages[part];
+    st->n = 0;
+    void (*raster)(const pose_volume_sampler *, size_t, const pose__vol_box *, int, int,
+                   pose__vol_stage *) = pose__volume_raster_tet_generic;
+#ifdef POSE__HAVE_AVX2_VOLUME
+    if (s->use_avx2)
+        raster = pose__volume_raster_tet_avx2;
+#endif
     for (size_t t = s->tet_count; t-- > 0;) {
         if (bx[t].k1 < z0 || bx[t].k0 > z1)
             continue;
-        pose__volume_raster_tet(s, t, &bx[t], bx[t].k0 > z0 ? bx[t].k0 : z0,
-                                bx[t].k1 < z1 ? bx[t].k1 : z1);
+        raster(s, t, &bx[t], bx[t].k0 > z0 ? bx[t].k0 : z0, bx[t].k1 < z1 ? bx[t].k1 : z1, st);
     }
+    pose__volume_gather(s, st);
 }
 
 static inline int covered_at(const pose_volume_sampler *s, size_t i, size_t j, size_t k)
