@@ -7,6 +7,9 @@
  * milliseconds of the whole process divided by the threads (CPU time per
  * thread: the figure that holds on a machine shared with other work, where
  * wall time waits for the cores), and the counts.
+ * Then the response (pose_set_contact_response): pose_apply with it off
+ * and on, per frame, on 1 and 2 threads: the difference is what the push
+ * adds.
  * Usage: bench_contact RIG [--seconds S]   (S per pose and thread count, default 1)
  */
 #include <stdio.h>
@@ -17,6 +20,52 @@
 #include "contact_body.h"
 #include "pose/contact.h"
 #include "pose/pose.h"
+
+/* Wall and CPU seconds per pose_apply of `st`, repeated for `seconds`. */
+static void time_apply(pose_state *st, double seconds, double *wall, double *cpu)
+{
+    int frames = 0;
+    const double w0 = bench_now(), c0 = bench_cpu_seconds();
+    do {
+        pose_apply(st);
+        frames++;
+    } while (bench_now() - w0 < seconds || frames < 3);
+    *wall = (bench_now() - w0) / frames;
+    *cpu = (bench_cpu_seconds() - c0) / frames;
+}
+
+static int bench_response(pose_rig *rig, double seconds)
+{
+    for (int threads = 1; threads <= 2; threads++) {
+        pose_state_options so = {.size = sizeof so, .threads = threads, .method = POSE_DQS};
+        pose_state *st;
+        if (pose_state_create_ex(rig, &so, &st) != POSE_OK) {
+            fprintf(stderr, "%s\n", pose_last_error());
+            return 1;
+        }
+        pose_contact_response on = {.size = sizeof on, .enabled = 1}, off = {.size = sizeof off};
+        pose_contact_response_stats rs = {.size = sizeof rs};
+        if (pose_set_contact_response(st, &on) != POSE_OK)
+            return 1;
+        pose_get_contact_response_stats(st, &rs);
+        printf("response, DQS, %d thread%s (built in %.0f ms)\n", threads, threads > 1 ? "s" : "",
+               1e3 * rs.build_seconds);
+        for (size_t p = 0; p < CONTACT_POSE_COUNT; p++) {
+            double w_off, c_off, w_on, c_on;
+            contact_pose_set(rig, st, &contact_poses[p]);
+            pose_set_contact_response(st, &off);
+            time_apply(st, seconds, &w_off, &c_off);
+            pose_set_contact_response(st, &on);
+            time_apply(st, seconds, &w_on, &c_on);
+            pose_get_contact_response_stats(st, &rs);
+            printf("  %-18s: pose_apply %6.2f -> %6.2f ms CPU per thread per frame (+%.2f; wall %.2f -> %.2f); "
+                   "%zu skin vertices pushed\n", contact_poses[p].label, 1e3 * c_off / threads, 1e3 * c_on / threads,
+                   1e3 * (c_on - c_off) / threads, 1e3 * w_off, 1e3 * w_on, rs.pushed);
+        }
+        pose_state_free(st);
+    }
+    return 0;
+}
 
 int main(int argc, char **argv)
 {
@@ -63,6 +112,7 @@ int main(int argc, char **argv)
         pose_contact_free(c);
     }
     pose_state_free(st);
+    const int r = bench_response(rig, seconds);
     pose_rig_free(rig);
-    return 0;
+    return r;
 }

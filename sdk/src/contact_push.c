@@ -65,11 +65,19 @@ static float push_vertex(const pose__push *p, const pose__push_bone *b, const fl
     const uint8_t state = cell_state(b, q);
     if (state == POSE__CELL_OUT)
         return 0.0f;
-    /* A point of a NEAR cell is within margin + 2 half-diagonals of the
-     * surface: the search stops there; one inside an IN cell searches on. */
-    const float reach = state == POSE__CELL_NEAR ? p->margin + 1.7320508f * b->cell : INFINITY;
+    /* A point of a NEAR cell is searched within the margin and a cell,
+     * where the surface nearly always is (a hit within a shorter reach is
+     * the nearest). Nothing there: outside, it is farther than the margin
+     * and stays; inside (a ray says so), it searches on, as one of an IN
+     * cell does. */
+    const float near = p->margin + 1.7320508f * b->cell;
     float c[3], out[3];
-    const float sd = pose__push_distance(b, q, reach, c, out);
+    float sd = pose__push_distance(b, q, state == POSE__CELL_NEAR ? near : INFINITY, c, out);
+    if (isinf(sd)) {
+        if (pose__bvh_winding_along(&b->tree, b->rest, q, f) <= 0)
+            return 0.0f;
+        sd = pose__push_distance(b, q, INFINITY, c, out);
+    }
     if (!(sd < p->margin))
         return 0.0f;
     /* Inside by the pseudo-normal is confirmed by the winding number (rays

@@ -26,7 +26,7 @@
 /** Grid cell states. */
 enum {
     POSE__CELL_OUT = 0,  /**< every point farther than the margin outside */
-    POSE__CELL_NEAR = 1, /**< the surface is within reach (push_build: near_reach) */
+    POSE__CELL_NEAR = 1, /**< a triangle's box, grown by the margin, touches it */
     POSE__CELL_IN = 2,   /**< every point inside, deeper than the margin */
 };
 

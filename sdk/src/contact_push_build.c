@@ -11,18 +11,13 @@
 #include "error.h"
 #include "state_internal.h"
 
-/* Grid spacing: a 64th of the bone's longest side, within [2, 8] mm (rig
- * in metres): coarse enough to build in well under a second for the body,
- * fine enough that only skin within a few mm of a bone needs an exact
- * query. */
+/* Grid spacing: a 128th of the bone's longest side, within [2, 4] mm (rig
+ * in metres): fine enough that only skin within a few mm of a bone needs
+ * an exact query (the per-frame cost), coarse enough that the thorax's
+ * grid stays near 2 M cells of one byte. */
 #define CELL_MIN 0.002f
-#define CELL_MAX 0.008f
-#define CELL_DIVISIONS 64.0f
-
-static float half_diagonal(float cell)
-{
-    return 0.8660254f * cell;
-}
+#define CELL_MAX 0.004f
+#define CELL_DIVISIONS 128.0f
 
 static void normalize3(float *v)
 {
@@ -136,9 +131,12 @@ float pose__push_distance(const pose__push_bone *b, const float *q, float max_di
     return side >= 0.0f ? d : -d;
 }
 
-/* The bone's sphere and grid: each cell's centre tells the state of the
- * whole cell (a surface within margin + half a diagonal of the centre, or
- * none, with the centre inside or out by the winding number). */
+/* The bone's sphere and grid. Cells that a triangle's box, grown by the
+ * margin, touches are NEAR; the other cells reachable from the grid's
+ * border through non-NEAR cells are OUT (a flood fill), the rest IN. No
+ * point of an OUT cell is inside or within the margin. (Where a bone's mesh is
+ * open the fill leaks in and its inside reads OUT: such points are not
+ * pushed.) */
 static pose_status bone_grid(pose__push_bone *b, const pose__tissue *ts, float margin, const pose_allocator *a)
 {
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -167,23 +165,64 @@ static pose_status bone_grid(pose__push_bone *b, const pose__tissue *ts, float m
         b->hi[d] = b->lo[d] + (float)b->dim[d] * b->cell;
         cells *= (size_t)b->dim[d];
     }
-    b->cells = pose__alloc(a, cells, POSE__ALIGN);
-    if (!b->cells)
+    b->cells = pose__calloc(a, cells, POSE__ALIGN);
+    uint32_t *queue = pose__alloc(a, cells * sizeof *queue, POSE__ALIGN);
+    if (!b->cells || !queue) {
+        pose__free(a, queue);
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for a bone grid of %zu cells", cells);
-    const float reach = margin + half_diagonal(b->cell);
+    }
+    const size_t sx = 1, sy = (size_t)b->dim[0], sz = (size_t)b->dim[0] * (size_t)b->dim[1];
+    for (size_t f = 0; f < ts->triangle_count; f++) {
+        int c0[3], c1[3];
+        for (int d = 0; d < 3; d++) {
+            const float *x = ts->positions;
+            const uint32_t *t = ts->triangles + 3 * f;
+            const float u = fminf(fminf(x[3 * (size_t)t[0] + (size_t)d], x[3 * (size_t)t[1] + (size_t)d]), x[3 * (size_t)t[2] + (size_t)d]);
+            const float w = fmaxf(fmaxf(x[3 * (size_t)t[0] + (size_t)d], x[3 * (size_t)t[1] + (size_t)d]), x[3 * (size_t)t[2] + (size_t)d]);
+            c0[d] = (int)floorf((u - margin - b->lo[d]) / b->cell);
+            c1[d] = (int)floorf((w + margin - b->lo[d]) / b->cell);
+            c0[d] = c0[d] < 0 ? 0 : c0[d];
+            c1[d] = c1[d] >= b->dim[d] ? b->dim[d] - 1 : c1[d];
+        }
+        for (int z = c0[2]; z <= c1[2]; z++)
+            for (int y = c0[1]; y <= c1[1]; y++)
+                for (int x = c0[0]; x <= c1[0]; x++)
+                    b->cells[(size_t)z * sz + (size_t)y * sy + (size_t)x * sx] = POSE__CELL_NEAR;
+    }
+    /* Flood OUT from the border; the cells never reached are IN. Unknown
+     * cells are 0 = POSE__CELL_OUT's value, so the fill marks reached cells
+     * with a temporary state first. */
+    enum { SEEN = 3 };
+    size_t head = 0, tail = 0;
     for (int z = 0; z < b->dim[2]; z++)
         for (int y = 0; y < b->dim[1]; y++)
             for (int x = 0; x < b->dim[0]; x++) {
-                const float c[3] = {b->lo[0] + ((float)x + 0.5f) * b->cell, b->lo[1] + ((float)y + 0.5f) * b->cell,
-                                    b->lo[2] + ((float)z + 0.5f) * b->cell};
-                pose__bvh_near n;
-                uint8_t state;
-                if (pose__bvh_nearest(&b->tree, b->rest, c, reach, &n) <= reach)
-                    state = POSE__CELL_NEAR;
-                else
-                    state = pose__bvh_winding(&b->tree, b->rest, c) > 0 ? POSE__CELL_IN : POSE__CELL_OUT;
-                b->cells[((size_t)z * (size_t)b->dim[1] + (size_t)y) * (size_t)b->dim[0] + (size_t)x] = state;
+                const int border = x == 0 || y == 0 || z == 0 || x == b->dim[0] - 1 || y == b->dim[1] - 1 ||
+                                   z == b->dim[2] - 1;
+                const size_t i = (size_t)z * sz + (size_t)y * sy + (size_t)x;
+                if (border && b->cells[i] == 0) {
+                    b->cells[i] = SEEN;
+                    queue[tail++] = (uint32_t)i;
+                }
             }
+    while (head < tail) {
+        const size_t i = queue[head++];
+        const int x = (int)(i % sy), y = (int)((i / sy) % (size_t)b->dim[1]), z = (int)(i / sz);
+        const int nx[6] = {x - 1, x + 1, x, x, x, x}, ny[6] = {y, y, y - 1, y + 1, y, y},
+                  nz[6] = {z, z, z, z, z - 1, z + 1};
+        for (int k = 0; k < 6; k++) {
+            if (nx[k] < 0 || ny[k] < 0 || nz[k] < 0 || nx[k] >= b->dim[0] || ny[k] >= b->dim[1] || nz[k] >= b->dim[2])
+                continue;
+            const size_t j = (size_t)nz[k] * sz + (size_t)ny[k] * sy + (size_t)nx[k];
+            if (b->cells[j] == 0) {
+                b->cells[j] = SEEN;
+                queue[tail++] = (uint32_t)j;
+            }
+        }
+    }
+    for (size_t i = 0; i < cells; i++)
+        b->cells[i] = b->cells[i] == SEEN ? POSE__CELL_OUT : b->cells[i] == 0 ? POSE__CELL_IN : b->cells[i];
+    pose__free(a, queue);
     return POSE_OK;
 }
 
