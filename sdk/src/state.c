@@ -238,11 +238,15 @@ void pose__state_transfer_task(void *ctx, unsigned part, unsigned parts)
     const pose__transfer_mesh *mesh = &st->rt->transfer;
     size_t b = pose__part_begin(mesh->block_count, part, parts);
     size_t e = pose__part_begin(mesh->block_count, part + 1, parts);
-    st->flagged_count[part] = pose__transfer(mesh, st->tet_positions, b, e, st->tissue_positions,
-                                             st->tissue_normals, st->flagged + b * POSE__BLOCK);
+    uint32_t *flagged = st->flagged + b * POSE__BLOCK;
+    if (st->rigid_bones) /* state_bones.c */
+        st->flagged_count[part] = pose__state_transfer_soft(st, b, e, flagged);
+    else
+        st->flagged_count[part] = pose__transfer(mesh, st->tet_positions, b, e,
+                                                 st->tissue_positions, st->tissue_normals, flagged);
     pose__state_place_outside(st, b * POSE__BLOCK, e * POSE__BLOCK); /* rig_outside.c */
     if (st->rigid_bones)
-        pose__state_place_bones(st, b * POSE__BLOCK, e * POSE__BLOCK); /* state_bones.c */
+        pose__state_place_bones(st, b * POSE__BLOCK, e * POSE__BLOCK);
 }
 
 /* Normals of the vertices in flat or inverted tets, from their triangles:
@@ -305,11 +309,11 @@ pose_status pose_apply(pose_state *st)
         pose__state_fem_refine(st); /* state_fem.c */
         t0 = pose__seconds();
     }
-    /* POSE_FEM's bones are rigid bodies, but the refinement moves the soft
-     * tets that hold part of each bone surface: those follow their joint.
-     * The skinning methods keep every tissue on their own field. */
-    /* Bones are rigid for FEM, and for the contact response, which pushes skin
-     * out of each bone as its joint moves it (contact_push.c). */
+    /* Bone tissues follow their joint (state_bones.c) for POSE_FEM, whose
+     * refinement moves the soft tets that hold part of each bone surface,
+     * and for the contact response, which pushes skin out of each bone as
+     * its joint moves it (contact_push.c). Otherwise the skinning methods
+     * keep every tissue on their own field. */
     pose__state_transfer_pass(st, st->method == POSE_FEM || st->push_enabled);
     if (st->method == POSE_FEM)
         st->fem_stats.seconds_transfer = pose__seconds() - t0;

@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Bone tissues moved by their joint's rigid motion (POSE_FEM, dynamics).
+/* Bone tissues moved by their joint's rigid motion (POSE_FEM, dynamics,
+ * the contact response).
  *
  * The bake embeds a bone surface's vertices in whatever tet holds them: a
  * voxelized bone is not its mesh, so part of them lie in soft tets around
@@ -11,9 +12,46 @@
  * bone surfaces under the dynamics' ramps). Both treat the bones as rigid
  * bodies, their tets' vertices held at, or sprung to, the skinned pose, so
  * a bone tissue of joint j is placed by j's skinning transform itself:
- * rest position and normal, rotated and moved. Vertex by vertex, as the
- * transfer: the same bits on any thread count. */
+ * rest position and normal, rotated and moved, and the transfer skips the
+ * blocks that hold bone vertices only. Vertex by vertex, as the transfer:
+ * the same bits on any thread count. */
+#include "rt_transfer.h"
 #include "state_internal.h"
+
+/* Tissue ts is placed by its joint, not by the transfer. */
+static int rigid(const pose__tissue *ts)
+{
+    return ts->kind == POSE_TISSUE_BONE && ts->joint >= 0;
+}
+
+size_t pose__state_transfer_soft(pose_state *st, size_t begin, size_t end, uint32_t *flagged)
+{
+    /* Bones are most of a body's tissue vertices (144 k of 158 k on the
+     * coarse bake): the transfer runs on the blocks holding any other
+     * vertex, runs of tissues at a time, each block once. */
+    const pose_rig *rig = st->rig;
+    const size_t *offset = st->rt->tissue_offset;
+    size_t count = 0, done = begin;
+    for (size_t t = 0; t < rig->tissue_count;) {
+        if (rigid(&rig->tissues[t])) {
+            t++;
+            continue;
+        }
+        const size_t v0 = offset[t];
+        while (t < rig->tissue_count && !rigid(&rig->tissues[t]))
+            t++;
+        const size_t v1 = offset[t];
+        size_t b = v0 / POSE__BLOCK, e = (v1 + POSE__BLOCK - 1) / POSE__BLOCK;
+        b = b > done ? b : done;
+        e = e < end ? e : end;
+        if (v1 > v0 && b < e) {
+            count += pose__transfer(&st->rt->transfer, st->tet_positions, b, e,
+                                    st->tissue_positions, st->tissue_normals, flagged + count);
+            done = e;
+        }
+    }
+    return count;
+}
 
 void pose__state_place_bones(pose_state *st, size_t begin, size_t end)
 {
@@ -21,18 +59,20 @@ void pose__state_place_bones(pose_state *st, size_t begin, size_t end)
     const size_t *offset = st->rt->tissue_offset;
     for (size_t t = 0; t < rig->tissue_count; t++) {
         const pose__tissue *ts = &rig->tissues[t];
-        if (ts->kind != POSE_TISSUE_BONE || ts->joint < 0)
-            continue;
         const size_t b = offset[t] > begin ? offset[t] : begin;
         const size_t e = offset[t + 1] < end ? offset[t + 1] : end;
+        if (!rigid(ts) || b >= e)
+            continue;
         const pose__xform *m = &st->skin[ts->joint];
+        float R[9];
+        pose__quat_to_matrix(m->q, R);
         for (size_t v = b; v < e; v++) {
-            float *p = st->tissue_positions + 3 * v, *n = st->tissue_normals + 3 * v;
-            pose__quat_rotate(p, m->q, ts->positions + 3 * (v - offset[t]));
-            p[0] += m->t[0];
-            p[1] += m->t[1];
-            p[2] += m->t[2];
-            pose__quat_rotate(n, m->q, st->rt->rest_normals + 3 * v);
+            const float *r = ts->positions + 3 * (v - offset[t]), *n = st->rt->rest_normals + 3 * v;
+            float *p = st->tissue_positions + 3 * v, *o = st->tissue_normals + 3 * v;
+            for (int a = 0; a < 3; a++) {
+                p[a] = R[3 * a] * r[0] + R[3 * a + 1] * r[1] + R[3 * a + 2] * r[2] + m->t[a];
+                o[a] = R[3 * a] * n[0] + R[3 * a + 1] * n[1] + R[3 * a + 2] * n[2];
+            }
         }
     }
 }

@@ -94,6 +94,10 @@ void pose__state_skin_pass(pose_state *st);
 /** Transfer of tet_positions to the tissues (positions, normals); with
  *  rigid_bones, bone tissues follow their joint instead (state_bones.c). */
 void pose__state_transfer_pass(pose_state *st, int rigid_bones);
+/** The transfer (pose__transfer) of the blocks among [begin, end) that
+ *  hold a vertex of a tissue other than a bone; flagged vertices listed
+ *  from `flagged`, their count returned (state_bones.c). */
+size_t pose__state_transfer_soft(pose_state *st, size_t begin, size_t end, uint32_t *flagged);
 /** Bone tissues' vertices among tissue vertices [begin, end) placed by
  *  their joint's skinning transform (positions and normals). */
 void pose__state_place_bones(pose_state *st, size_t begin, size_t end);
