@@ -21,14 +21,12 @@ typedef struct pose__vol_box {
     int32_t i0, i1, j0, j1, k0, k1;
 } pose__vol_box;
 
-/* Voxels staged for sampling (one per slab part, at most
+/* Voxels staged for sampling (one queue per slab part, at most
  * POSE__VOL_STAGE + POSE__VOL_STAGE_SLACK): the output voxel and its
- * preimage in the rest image's index space, whose trilinear cell lies in
- * the image (a tet's rest vertices all do: POSE__VOL_REST_INSIDE). Rows are
- * short (two voxels on average on the bundled CT), so the rasterizer queues
- * them and the gather samples them in batches, eight at a time where the
- * CPU has AVX2. The slack lets a short run be queued with fixed-width
- * stores. */
+ * preimage in the rest image's index space. Rows are short (two voxels on
+ * average on the bundled CT), so the rasterizer queues them and the gather
+ * samples them in batches, eight at a time where the CPU has AVX2. The
+ * slack lets a short run be queued with fixed-width stores. */
 #define POSE__VOL_STAGE 512
 #define POSE__VOL_STAGE_SLACK 8
 typedef struct pose__vol_stage {
@@ -69,21 +67,43 @@ struct pose_volume_sampler {
 
 /* What a tet's rest positions say, once per sampler: the sign of its
  * volume in the rest image's index space (the posed one must match, or
- * the tet is folded), and whether all four lie inside the image's cells
- * (its preimages need no clamping). */
+ * the tet is folded). */
 #define POSE__VOL_REST_POSITIVE 1
 #define POSE__VOL_REST_NEGATIVE 2
-#define POSE__VOL_REST_INSIDE 4
 
 /** The POSE__VOL_REST_* flags of a tet with rest vertices r (rest index
- *  space) in an image of grid g. */
-int pose__volume_rest_flags(const pose_volume_grid *g, const float *r[4]);
+ *  space). */
+int pose__volume_rest_flags(const float *r[4]);
+
+/* The rest image's cells as the gather reads them. */
+typedef struct pose__vol_cells {
+    float out[3];      /* n - 0.5: a preimage beyond (or under -0.5) is outside the image */
+    float top[3];      /* n - 1: the last voxel centre, where preimages are clamped */
+    int last_cell[3];  /* max(n - 2, 0): the last cell's lower corner */
+    size_t step[3];    /* to the next voxel on an axis; 0 on an axis of one voxel */
+    size_t row, plane; /* nx, nx ny */
+} pose__vol_cells;
+
+static inline pose__vol_cells pose__vol_cells_of(const pose_volume_grid *g)
+{
+    const uint32_t n[3] = {g->nx, g->ny, g->nz};
+    const size_t stride[3] = {1, g->nx, (size_t)g->nx * g->ny};
+    pose__vol_cells c;
+    for (int a = 0; a < 3; a++) {
+        c.out[a] = (float)n[a] - 0.5f;
+        c.top[a] = (float)(n[a] - 1);
+        c.last_cell[a] = n[a] > 1 ? (int)n[a] - 2 : 0;
+        c.step[a] = n[a] > 1 ? stride[a] : 0;
+    }
+    c.row = stride[1], c.plane = stride[2];
+    return c;
+}
 
 
 /** Rasterize posed tet `t` (its box `box`) into output planes k0..k1 (one
- *  slab's share of the box): its covered voxels get the rest image sampled
- *  through the tet's inverse map (queued in `st` when the tet lies inside
- *  the image) and their covered bits. The values a voxel gets depend on
+ *  slab's share of the box): its covered voxels are queued in `st` with
+ *  their preimages through the tet's inverse map (the gather samples the
+ *  rest image there), and get their covered bits. The values a voxel gets depend on
  *  the tet and the voxel only, never on k0/k1 or the queue, so any slab
  *  split gives the same bytes. Two variants (volume_raster_body.h), the
  *  same bytes. */

@@ -4,18 +4,12 @@
 #define POSE__VR(name) name##_generic
 #include "volume_raster_body.h"
 
-int pose__volume_rest_flags(const pose_volume_grid *g, const float *r[4])
+int pose__volume_rest_flags(const float *r[4])
 {
     double E[3][3];
     for (int a = 0; a < 3; a++)
         for (int c = 0; c < 3; c++)
             E[a][c] = (double)r[c + 1][a] - r[0][a];
     const double det = det3(E);
-    int flags = det > 0 ? POSE__VOL_REST_POSITIVE : det < 0 ? POSE__VOL_REST_NEGATIVE : 0;
-    const float lim[3] = {(float)g->nx - 1.001f, (float)g->ny - 1.001f, (float)g->nz - 1.001f};
-    int inside = 1;
-    for (int c = 0; c < 4; c++)
-        for (int a = 0; a < 3; a++)
-            inside &= r[c][a] >= 0.001f && r[c][a] <= lim[a];
-    return flags | (inside ? POSE__VOL_REST_INSIDE : 0);
+    return det > 0 ? POSE__VOL_REST_POSITIVE : det < 0 ? POSE__VOL_REST_NEGATIVE : 0;
 }

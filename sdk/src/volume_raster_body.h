@@ -20,52 +20,6 @@
 #include "rt_vec.h" /* POSE__INLINE */
 #include "volume_internal.h"
 
-static inline float clampf(float v, float lo, float hi)
-{
-    return v < lo ? lo : v > hi ? hi : v; /* NaN -> hi: still inside the image */
-}
-
-/* One voxel of the output from the rest image at index-space point (x, y, z):
- * intensity trilinear, label of the nearest voxel; a point more than half a
- * voxel outside the image gets the background (the scan has no data
- * there), within that margin coordinates are clamped to the image. */
-static inline void sample_rest(const pose_volume_desc *rest, float x, float y, float z,
-                               float *dst_i, uint16_t *dst_l, size_t at)
-{
-    const int nx = (int)rest->grid.nx, ny = (int)rest->grid.ny, nz = (int)rest->grid.nz;
-    if (x < -0.5f || y < -0.5f || z < -0.5f || x > (float)nx - 0.5f || y > (float)ny - 0.5f ||
-        z > (float)nz - 0.5f) {
-        if (dst_l)
-            dst_l[at] = rest->label_background;
-        if (dst_i)
-            dst_i[at] = rest->intensity_background;
-        return;
-    }
-    x = clampf(x, 0.0f, (float)(nx - 1));
-    y = clampf(y, 0.0f, (float)(ny - 1));
-    z = clampf(z, 0.0f, (float)(nz - 1));
-    if (dst_l) {
-        int li = (int)(x + 0.5f), lj = (int)(y + 0.5f), lk = (int)(z + 0.5f);
-        dst_l[at] = rest->labels[((size_t)lk * (size_t)ny + (size_t)lj) * (size_t)nx + (size_t)li];
-    }
-    if (!dst_i)
-        return;
-    int i = (int)x, j = (int)y, k = (int)z;
-    i -= i > nx - 2 && i > 0;
-    j -= j > ny - 2 && j > 0;
-    k -= k > nz - 2 && k > 0;
-    float fx = x - (float)i, fy = y - (float)j, fz = z - (float)k;
-    const size_t sx = nx > 1 ? 1 : 0, sy = ny > 1 ? (size_t)nx : 0,
-                 sz = nz > 1 ? (size_t)nx * (size_t)ny : 0;
-    const float *p = rest->intensity + ((size_t)k * (size_t)ny + (size_t)j) * (size_t)nx + (size_t)i;
-    float c00 = p[0] + fx * (p[sx] - p[0]);
-    float c10 = p[sy] + fx * (p[sy + sx] - p[sy]);
-    float c01 = p[sz] + fx * (p[sz + sx] - p[sz]);
-    float c11 = p[sz + sy] + fx * (p[sz + sy + sx] - p[sz + sy]);
-    float c0 = c00 + fy * (c10 - c00), c1 = c01 + fy * (c11 - c01);
-    dst_i[at] = c0 + fz * (c1 - c0);
-}
-
 /* The preimages of a row's span: voxel ia + u maps to r + m u (from ia
  * whichever run of the span is sampled, so a voxel's value does not
  * depend on the runs). */
@@ -74,23 +28,12 @@ typedef struct span {
     int ia, ib;
 } span;
 
-/* A span whose preimage may leave the image: clamps and background. */
-static void row_clamped(const pose_volume_desc *rest, const span *sp, int i0, int i1, float *oi,
-                        uint16_t *ol)
-{
-    for (int i = i0; i <= i1; i++) {
-        const float u = (float)(i - sp->ia);
-        sample_rest(rest, sp->rx + sp->mx * u, sp->ry + sp->my * u, sp->rz + sp->mz * u, oi, ol,
-                    (size_t)i);
-    }
-}
-
 /* Four floats (SSE2 everywhere x86-64 and ARMv8 run): a run's preimages
  * four at a time. */
 typedef float v4f __attribute__((vector_size(16)));
 typedef uint32_t v4u __attribute__((vector_size(16)));
 
-/* Queues voxels i0..i1 of output row `row` (a tet inside the image), four
+/* Queues voxels i0..i1 of output row `row`, four
  * at a time: a run of up to four, the common case, is one set of vector
  * stores (the queue's slack takes the surplus), not a loop whose length
  * the branch predictor would have to guess. Preimages as the generic
@@ -116,22 +59,12 @@ static POSE__INLINE void queue_run(const pose_volume_sampler *s, pose__vol_stage
     }
 }
 
-static POSE__INLINE void sample_run(const pose_volume_sampler *s, pose__vol_stage *st,
-                                    const span *sp, int inside, int i0, int i1, size_t row)
-{
-    if (inside)
-        queue_run(s, st, sp, i0, i1, row);
-    else
-        row_clamped(&s->rest, sp, i0, i1, s->dst_intensity ? s->dst_intensity + row : NULL,
-                    s->dst_labels ? s->dst_labels + row : NULL);
-}
-
 /* The general case of cover_span: a span over several words of the row,
  * or one some of whose voxels an earlier tet covered (out of line: it
  * keeps the common case's loop small). */
 static __attribute__((noinline)) void cover_words(const pose_volume_sampler *s,
-                                                  pose__vol_stage *st, const span *sp,
-                                                  int inside, uint64_t *w, size_t row)
+                                                  pose__vol_stage *st, const span *sp, uint64_t *w,
+                                                  size_t row)
 {
     const int a = sp->ia >> 6, b = sp->ib >> 6;
     const uint64_t first = ~(uint64_t)0 << (sp->ia & 63), last = ~(uint64_t)0 >> (63 - (sp->ib & 63));
@@ -143,7 +76,7 @@ static __attribute__((noinline)) void cover_words(const pose_volume_sampler *s,
             const int lo = __builtin_ctzll(open);
             const uint64_t after = ~(open >> lo);
             const int len = after ? __builtin_ctzll(after) : 64 - lo;
-            sample_run(s, st, sp, inside, 64 * x + lo, 64 * x + lo + len - 1, row);
+            queue_run(s, st, sp, 64 * x + lo, 64 * x + lo + len - 1, row);
             open = lo + len < 64 ? open & (~(uint64_t)0 << (lo + len)) : 0;
         }
     }
@@ -155,15 +88,15 @@ static __attribute__((noinline)) void cover_words(const pose_volume_sampler *s,
  * sampled once, by the first tet the slab visits (the later in index
  * order), whatever the slab split. */
 static POSE__INLINE void cover_span(const pose_volume_sampler *s, pose__vol_stage *st,
-                                    const span *sp, int inside, uint64_t *w, size_t row)
+                                    const span *sp, uint64_t *w, size_t row)
 {
     const int a = sp->ia >> 6;
     const uint64_t m = (~(uint64_t)0 << (sp->ia & 63)) & (~(uint64_t)0 >> (63 - (sp->ib & 63)));
     if (a == sp->ib >> 6 && !(w[a] & m)) { /* the common case: one word, nothing covered yet */
         w[a] |= m;
-        sample_run(s, st, sp, inside, sp->ia, sp->ib, row);
+        queue_run(s, st, sp, sp->ia, sp->ib, row);
     } else {
-        cover_words(s, st, sp, inside, w, row);
+        cover_words(s, st, sp, w, row);
     }
 }
 
@@ -376,7 +309,6 @@ void POSE__VR(pose__volume_raster_tet)(const pose_volume_sampler *s, size_t t,
               jhi_v = v4_load(jhi_add), ba_v = v4_load(ba), bj_v = v4_load(bj), bk_v = v4_load(bk),
               lo_v = v4_load(lo_add), hi_v = v4_load(hi_add), R_v = v4_load(Rv), Mi_v = v4_load(Mi),
               Mj_v = v4_load(Mj), Mk_v = v4_load(Mk);
-    const int inside = flags & POSE__VOL_REST_INSIDE;
     const size_t nx = s->out.nx, ny = s->out.ny;
     const double i0 = box->i0, i1 = box->i1;
     span sp = {.mx = (float)M[0][0], .my = (float)M[1][0], .mz = (float)M[2][0]};
@@ -401,7 +333,7 @@ void POSE__VR(pose__volume_raster_tet)(const pose_volume_sampler *s, size_t t,
                 continue;
             const v4d r0 = v4_madd(v4_madd(rk, Mj_v, jd), Mi_v, (double)sp.ia);
             sp.rx = (float)v4_lane(r0, 0), sp.ry = (float)v4_lane(r0, 1), sp.rz = (float)v4_lane(r0, 2);
-            cover_span(s, st, &sp, inside, pose__vol_cover_row(s, (size_t)j, (size_t)k),
+            cover_span(s, st, &sp, pose__vol_cover_row(s, (size_t)j, (size_t)k),
                        ((size_t)k * ny + (size_t)j) * nx);
         }
     }

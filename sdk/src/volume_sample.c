@@ -158,7 +158,7 @@ pose_status pose_volume_sampler_create(const pose_rig *rig, const pose_volume_de
         const float *r[4];
         for (int c = 0; c < 4; c++)
             r[c] = s->rest_index + 3 * (size_t)ti.tets[4 * t + c];
-        s->tet_flags[t] = (uint8_t)pose__volume_rest_flags(&rest->grid, r);
+        s->tet_flags[t] = (uint8_t)pose__volume_rest_flags(r);
     }
     *out = s;
     return POSE_OK;
