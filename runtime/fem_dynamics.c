@@ -450,38 +450,62 @@ static void product_group(const pose__fem_mesh *m, pose__fem_work *w, pose__fem_
  * warm-started, most tets converge in a few; the rest go on next step). */
 #define FEM_POLAR_STEPS 8
 
-static void pass_task(void *ctx, unsigned part, unsigned parts)
+/* The skin volume term at x: its gradient (work->gvol), force factor and
+ * g . v per island for the warm start's product (serial code, one order:
+ * one item of the rotate pass, running beside the tets). */
+static void volume_item(step_ctx *c)
+{
+    const pose__fem_mesh *m = c->mesh;
+    pose__fem_dyn *d = c->d;
+    c->vol_force = (float)pose__fem_volume_gradient(m, c->w, d->x);
+    for (size_t i = 0; i < d->island_count; i++)
+        d->isl[i].gu = 0.0;
+    if (m->surface.vertex_count == 0)
+        return;
+    for (size_t v = 0; v < m->vertex_count; v++) {
+        const float *g = c->w->gvol + 3 * v, *vel = d->v + 3 * v;
+        if (d->island[v] != POSE__FEM_KINEMATIC)
+            d->isl[d->island[v]].gu +=
+                (double)g[0] * vel[0] + (double)g[1] * vel[1] + (double)g[2] * vel[2];
+    }
+}
+
+/* Items of a pass: tet passes take groups of POSE__FEM_GROUP blocks (the
+ * rotate pass the volume term first), vertex passes chunks. */
+static size_t pass_items(const step_ctx *c)
+{
+    const size_t ng = pose__fem_dyn_groups(c->mesh);
+    return c->pass == PASS_ROTATE ? 1 + ng : c->pass == PASS_PRODUCT ? ng : c->mesh->chunk_count;
+}
+
+static void pass_item(void *ctx, size_t item)
 {
     step_ctx *c = ctx;
     const pose__fem_mesh *m = c->mesh;
-    pose__fem_work *w = c->w;
     pose__fem_dyn *d = c->d;
     if (c->pass == PASS_ROTATE) { /* with K v: the warm start's product */
-        const size_t nb = pose__fem_dyn_blocks(m);
-        const size_t b = pose__part_begin(nb, part, parts), e = pose__part_begin(nb, part + 1, parts);
+        if (item == 0) {
+            volume_item(c);
+            return;
+        }
+        const size_t nb = pose__fem_dyn_blocks(m), b = (item - 1) * POSE__FEM_GROUP;
+        const size_t e = b + POSE__FEM_GROUP < nb ? b + POSE__FEM_GROUP : nb;
         pose__fem_dyn_rotate(d->tets, d->rot, d->x, d->v, FEM_POLAR_STEPS, d->f, d->kv, d->blk, b, e);
         return;
     }
     if (c->pass == PASS_PRODUCT) {
-        const size_t ng = pose__fem_dyn_groups(m);
-        for (size_t g = pose__part_begin(ng, part, parts); g < pose__part_begin(ng, part + 1, parts); g++)
-            product_group(m, w, d, g);
+        product_group(m, c->w, d, item);
         return;
     }
-    const size_t kb = pose__part_begin(m->chunk_count, part, parts);
-    const size_t ke = pose__part_begin(m->chunk_count, part + 1, parts);
     if (c->pass == PASS_INTEGRATE) {
-        for (size_t k = kb; k < ke; k++)
-            integrate_chunk(c, k);
+        integrate_chunk(c, item);
         return;
     }
-    for (size_t k = kb; k < ke; k++) {
-        size_t chunk_end = (k + 1) * POSE__FEM_CHUNK;
-        if (chunk_end > m->vertex_count)
-            chunk_end = m->vertex_count;
-        for (uint32_t s = d->seg_offset[k]; s < d->seg_offset[k + 1]; s++)
-            segment_pass(c, s, s + 1 < d->seg_offset[k + 1] ? d->seg_first[s + 1] : chunk_end);
-    }
+    size_t chunk_end = (item + 1) * POSE__FEM_CHUNK;
+    if (chunk_end > m->vertex_count)
+        chunk_end = m->vertex_count;
+    for (uint32_t s = d->seg_offset[item]; s < d->seg_offset[item + 1]; s++)
+        segment_pass(c, s, s + 1 < d->seg_offset[item + 1] ? d->seg_first[s + 1] : chunk_end);
 }
 
 /* Below this many tets the caller works alone (as pose__fem_solve). */
@@ -492,10 +516,12 @@ static void pass_task(void *ctx, unsigned part, unsigned parts)
 static void run(step_ctx *c, pose__pool *pool, int pass)
 {
     c->pass = pass;
+    const size_t n = pass_items(c);
     if (pool && pose__pool_threads(pool) > 1 && c->mesh->tet_count >= FEM_SERIAL_TETS)
-        pose__pool_run(pool, pass_task, c);
+        pose__pool_run_items(pool, pass_item, c, n);
     else
-        pass_task(c, 0, 1);
+        for (size_t i = 0; i < n; i++)
+            pass_item(c, i);
     pose__fem_dyn *d = c->d;
     if (pass == PASS_PRODUCT) { /* the tets' u^T K u per island, group after group */
         for (size_t i = 0; i < d->island_count; i++)
@@ -543,22 +569,13 @@ void pose__fem_dyn_step(const pose__fem_mesh *m, pose__fem_work *w, pose__fem_dy
     for (size_t i = 0; i < (ni > 0 ? ni : 1); i++)
         d->beta[i] = d->alpha[i] = 0.0f;
     for (size_t i = 0; i < ni; i++) {
-        d->isl[i].gu = 0.0;
         d->isl[i].active = 0;
         d->isl[i].iterations = 0;
     }
     /* Assembly: rotations, elastic forces at x and K v in one pass over the
-     * tets, then per vertex the right-hand side, the preconditioner (blocks
+     * tets (the skin's volume term as one more item), then per vertex the right-hand side, the preconditioner (blocks
      * of A) and the residual of the warm start v. */
-    run(&c, pool, PASS_ROTATE);
-    c.vol_force = (float)pose__fem_volume_gradient(m, w, d->x);
-    if (m->surface.vertex_count > 0) /* g . v per island for the volume term's K v (serial: one order) */
-        for (size_t v = 0; v < m->vertex_count; v++) {
-            const float *g = w->gvol + 3 * v, *vel = d->v + 3 * v;
-            if (d->island[v] != POSE__FEM_KINEMATIC)
-                d->isl[d->island[v]].gu += (double)g[0] * vel[0] + (double)g[1] * vel[1] +
-                                           (double)g[2] * vel[2];
-        }
+    run(&c, pool, PASS_ROTATE); /* with the volume term beside the tets */
     run(&c, pool, PASS_RESIDUAL);
     const double tol2 = (double)prm->tolerance * prm->tolerance;
     int any = 0;

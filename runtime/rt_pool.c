@@ -27,10 +27,19 @@ struct pose__pool {
     pose__cond done;              /* signalled when the last worker finishes */
     unsigned threads;
     _Atomic unsigned pending;     /* workers still running the current task */
-    _Atomic uint64_t generation;  /* task counter: a worker runs each generation once */
+    /* Task counter, times 2, plus 1 for an item task (pose__pool_run_items):
+     * a worker runs each generation once, and reads its kind with it. */
+    _Atomic uint64_t generation;
     _Atomic int stop;
     pose__task_fn fn;             /* written before generation is bumped (release) */
     void *ctx;
+    /* Item tasks: workers take items while the task is open; the caller
+     * closes it when none is left and waits only for the workers inside. */
+    pose__item_fn item_fn;
+    size_t items;
+    _Atomic size_t next;          /* next item to take */
+    _Atomic int open;
+    _Atomic unsigned inside;      /* workers that entered the open task */
     struct pose__worker workers[]; /* threads - 1 */
 };
 
@@ -78,6 +87,28 @@ static int spin_for_done(pose__pool *p)
     }
 }
 
+/* Take items until none is left. */
+static void take_items(pose__pool *p)
+{
+    for (;;) {
+        const size_t i = atomic_fetch_add_explicit(&p->next, 1, memory_order_relaxed);
+        if (i >= p->items)
+            return;
+        p->item_fn(p->ctx, i);
+    }
+}
+
+/* A worker's turn at an item task. It may come late, after the task was
+ * closed (it never reads the task then) or while a later one is open (it
+ * helps with that one: its fields were written before it opened). */
+static void worker_items(pose__pool *p)
+{
+    atomic_fetch_add_explicit(&p->inside, 1, memory_order_seq_cst);
+    if (atomic_load_explicit(&p->open, memory_order_seq_cst))
+        take_items(p);
+    atomic_fetch_sub_explicit(&p->inside, 1, memory_order_release);
+}
+
 static void *worker_main(void *arg)
 {
     struct pose__worker *w = arg;
@@ -93,6 +124,10 @@ static void *worker_main(void *arg)
         if (atomic_load_explicit(&p->stop, memory_order_acquire))
             break;
         seen = atomic_load_explicit(&p->generation, memory_order_acquire);
+        if (seen & 1u) {
+            worker_items(p);
+            continue;
+        }
         p->fn(p->ctx, w->part, p->threads);
         if (atomic_fetch_sub_explicit(&p->pending, 1, memory_order_acq_rel) == 1) {
             /* under the lock: the caller may be between its check and its wait */
@@ -106,10 +141,11 @@ static void *worker_main(void *arg)
 
 /* Bump the generation under the lock (sleeping workers re-check it there)
  * and wake the sleepers; polling workers see it directly. */
-static void post(pose__pool *p)
+static void post(pose__pool *p, int items)
 {
     pose__mutex_lock(&p->lock);
-    atomic_fetch_add_explicit(&p->generation, 1, memory_order_release);
+    const uint64_t g = atomic_load_explicit(&p->generation, memory_order_relaxed);
+    atomic_store_explicit(&p->generation, (g | 1u) + 1u + (items ? 1u : 0u), memory_order_release);
     pose__cond_broadcast(&p->start);
     pose__mutex_unlock(&p->lock);
 }
@@ -117,7 +153,7 @@ static void post(pose__pool *p)
 static void stop_workers(pose__pool *p, unsigned started)
 {
     atomic_store_explicit(&p->stop, 1, memory_order_release);
-    post(p);
+    post(p, 0);
     for (unsigned i = 0; i < started; i++)
         pose__thread_join(&p->workers[i].thread);
     pose__cond_destroy(&p->done);
@@ -133,7 +169,12 @@ int pose__pool_init(pose__pool *p, unsigned threads)
     atomic_init(&p->pending, 0);
     atomic_init(&p->generation, 0);
     atomic_init(&p->stop, 0);
+    atomic_init(&p->next, 0);
+    atomic_init(&p->open, 0);
+    atomic_init(&p->inside, 0);
     p->fn = NULL;
+    p->item_fn = NULL;
+    p->items = 0;
     p->ctx = NULL;
     if (pose__mutex_init(&p->lock) != 0)
         return -1;
@@ -178,7 +219,7 @@ void pose__pool_run(pose__pool *p, pose__task_fn fn, void *ctx)
     p->fn = fn;
     p->ctx = ctx;
     atomic_store_explicit(&p->pending, p->threads - 1, memory_order_relaxed);
-    post(p);
+    post(p, 0);
     fn(ctx, 0, p->threads);
     if (spin_for_done(p))
         return;
@@ -186,4 +227,25 @@ void pose__pool_run(pose__pool *p, pose__task_fn fn, void *ctx)
     while (atomic_load_explicit(&p->pending, memory_order_acquire) > 0)
         pose__cond_wait(&p->done, &p->lock);
     pose__mutex_unlock(&p->lock);
+}
+
+void pose__pool_run_items(pose__pool *p, pose__item_fn fn, void *ctx, size_t items)
+{
+    p->item_fn = fn;
+    p->ctx = ctx;
+    p->items = items;
+    atomic_store_explicit(&p->next, 0, memory_order_relaxed);
+    if (p->threads == 1) {
+        take_items(p);
+        return;
+    }
+    atomic_store_explicit(&p->open, 1, memory_order_seq_cst);
+    post(p, 1);
+    take_items(p);
+    /* Close, then wait for the workers that entered: each is finishing its
+     * last item; one that enters now finds the task closed. A worker that
+     * has not woken up is not waited for. */
+    atomic_store_explicit(&p->open, 0, memory_order_seq_cst);
+    while (atomic_load_explicit(&p->inside, memory_order_acquire) > 0)
+        cpu_relax();
 }

@@ -27,6 +27,17 @@ unsigned pose__pool_threads(const pose__pool *pool);
 /** Run fn(ctx, i, n) for i in 0..n-1 (part 0 on the caller) and wait for all. */
 void pose__pool_run(pose__pool *pool, pose__task_fn fn, void *ctx);
 
+/** An item of an item task: do item `item`. */
+typedef void (*pose__item_fn)(void *ctx, size_t item);
+/**
+ * Run fn(ctx, i) for i in 0..items-1, each once, on whichever threads take
+ * them (the caller takes items too) and wait for all. Items go to whoever
+ * is running: a worker the OS has not scheduled (a loaded machine) is not
+ * waited for, where pose__pool_run waits for every part. Results do not
+ * depend on who runs an item when each item writes only its own outputs.
+ */
+void pose__pool_run_items(pose__pool *pool, pose__item_fn fn, void *ctx, size_t items);
+
 /** Start of part `part` of `parts` over n items (end = start of part + 1). */
 static inline size_t pose__part_begin(size_t n, unsigned part, unsigned parts)
 {

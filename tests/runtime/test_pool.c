@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* The worker pool: every part runs exactly once per task, on the worker
  * that owns it, with the caller's writes visible to it and its writes
- * visible after pose__pool_run returns (run under TSan with -DPOSE_TSAN=ON). */
+ * visible after pose__pool_run returns; item tasks run every item once
+ * (run under TSan with -DPOSE_TSAN=ON). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -102,6 +103,54 @@ static void test_pool_sleeps_and_wakes(void **unused)
     }
 }
 
+/* An item task's item: adds the round to its slot (each item once per
+ * task); the first item of some rounds outlasts the polling. */
+static void item(void *ctx, size_t i)
+{
+    job *j = ctx;
+    if (i == 0 && j->round % 5 == 0)
+        sleep_ms(1);
+    j->data[i] += j->round;
+}
+
+/* Item tasks, back to back, after pauses, and between part tasks: every
+ * item runs exactly once per task and its write is seen when the call
+ * returns (workers that wake late must not touch a closed task). */
+static void test_pool_items(void **unused)
+{
+    (void)unused;
+    for (unsigned threads = 1; threads <= 3; threads++) {
+        pose__pool *pool = aligned_alloc(64, (pose__pool_size(threads) + 63) & ~(size_t)63);
+        assert_non_null(pool);
+        assert_int_equal(pose__pool_init(pool, threads), 0);
+        job *j = calloc(1, sizeof *j);
+        int parts_runs = 0;
+        for (int r = 1; r <= 300; r++) {
+            if (r % 50 == 0)
+                sleep_ms(2); /* the workers are asleep */
+            j->round = r;
+            const size_t n = (size_t)(r % 7 == 0 ? 1 : 1 + r % 97);
+            pose__pool_run_items(pool, item, j, n);
+            for (size_t i = 0; i < ITEMS; i++)
+                if (i < n)
+                    j->data[i] -= r; /* undone: data stays 0 if each ran once */
+            if (r % 3 == 0) {
+                pose__pool_run(pool, task, j); /* a part task between item tasks */
+                parts_runs++;
+                for (size_t i = 0; i < ITEMS; i++)
+                    j->data[i] -= (int)i;
+            }
+            for (size_t i = 0; i < ITEMS; i++)
+                assert_int_equal(j->data[i], 0);
+        }
+        for (unsigned p = 0; p < threads; p++)
+            assert_int_equal(j->runs[p], parts_runs);
+        free(j);
+        pose__pool_destroy(pool);
+        free(pool);
+    }
+}
+
 static void test_part_ranges_cover(void **unused)
 {
     (void)unused;
@@ -118,6 +167,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_part_ranges_cover),
+        cmocka_unit_test(test_pool_items),
         cmocka_unit_test(test_pool_runs_every_part_once),
         cmocka_unit_test(test_pool_sleeps_and_wakes),
     };
