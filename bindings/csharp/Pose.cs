@@ -24,7 +24,7 @@ namespace Pose
     public enum Status { OK = 0, Clamped = 1, InvalidArgument = -1, OutOfMemory = -2, IO = -3, Format = -4,
                          Version = -5, Checksum = -6, InvalidData = -7, Unsupported = -8, NotFound = -9,
                          Thread = -10 }
-    public enum Method { LBS = 0, DQS = 1, COR = 2 }
+    public enum Method { LBS = 0, DQS = 1, COR = 2, FEM = 3 }
     public enum EulerOrder { XYZ = 0, XZY = 1, YXZ = 2, YZX = 3, ZXY = 4, ZYX = 5 }
     public enum TissueKind { Skin = 0, Bone = 1, Muscle = 2, Organ = 3, Other = 4 }
     public enum Play { Realtime = 0, AsFastAsPossible = 1, Manual = 2 }
@@ -43,6 +43,34 @@ namespace Pose
 
     [StructLayout(LayoutKind.Sequential)]
     public struct StateOptions { public UIntPtr Size; public Allocator Allocator; public int Threads; public Method Method; }
+
+    /// <summary>pose_dynamics_options: start from DynamicsOptions.Defaults().</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct DynamicsOptions
+    {
+        public UIntPtr Size;
+        public float MassDamping, StiffnessDamping;
+        [MarshalAs(UnmanagedType.ByValArray, SizeConst = 3)] public float[] Gravity;
+        public float CouplingStiffness, Tolerance;
+        public int CgIterations;
+
+        public static DynamicsOptions Defaults()
+        {
+            var o = new DynamicsOptions { Gravity = new float[3] };
+            Native.pose_dynamics_defaults(ref o);
+            return o;
+        }
+    }
+
+    /// <summary>pose_dynamics_stats: what the last State.Step did.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct DynamicsStats
+    {
+        public UIntPtr Size;
+        public int Islands, CgIterations;
+        public double Residual, KineticEnergy, Time;
+        public double SecondsSkin, SecondsAssembly, SecondsCg, SecondsTransfer;
+    }
 
     [StructLayout(LayoutKind.Sequential)]
     public struct Transform
@@ -148,6 +176,12 @@ namespace Pose
         [DllImport(Lib)] public static extern IntPtr pose_tissue_normals(StateHandle state, int tissue, out UIntPtr count);
         [DllImport(Lib)] public static extern Status pose_joint_world(StateHandle state, int joint, out Transform world);
         [DllImport(Lib)] public static extern Status pose_state_bounds(StateHandle state, int tissue, float[] min, float[] max);
+        [DllImport(Lib)] public static extern int pose_rig_has_fem(RigHandle rig);
+        [DllImport(Lib)] public static extern void pose_dynamics_defaults(ref DynamicsOptions options);
+        [DllImport(Lib)] public static extern Status pose_set_dynamics_options(StateHandle state, ref DynamicsOptions options);
+        [DllImport(Lib)] public static extern Status pose_step(StateHandle state, double dt);
+        [DllImport(Lib)] public static extern Status pose_reset_dynamics(StateHandle state);
+        [DllImport(Lib)] public static extern Status pose_get_dynamics_stats(StateHandle state, ref DynamicsStats stats);
         [DllImport(Bridge)] public static extern Status pose_bridge_open(string source, RigHandle rig, ref BridgeOptions options, out IntPtr bridge);
         [DllImport(Bridge)] public static extern void pose_bridge_close(IntPtr bridge);
         [DllImport(Bridge)] public static extern Status pose_bridge_apply(BridgeHandle bridge, StateHandle state, out BridgeFrame frame);
@@ -217,6 +251,8 @@ namespace Pose
         public int JointCount { get { return (int)Native.pose_rig_joint_count(Handle); } }
         public int TissueCount { get { return (int)Native.pose_rig_tissue_count(Handle); } }
         public uint FormatVersion { get { return Native.pose_rig_format_version(Handle.DangerousGetHandle()); } }
+        /// <summary>Whether Method.FEM and State.Step work on this rig (its fem section).</summary>
+        public bool HasFem { get { return Native.pose_rig_has_fem(Handle) != 0; } }
 
         public int FindJoint(string name)
         {
@@ -307,6 +343,24 @@ namespace Pose
         }
 
         public void Apply() { Native.Check(Native.pose_apply(Handle)); }
+
+        /// <summary>Dynamics settings (pose_set_dynamics_options); allocates the simulation.</summary>
+        public void SetDynamics(DynamicsOptions options)
+        {
+            options.Size = (UIntPtr)Marshal.SizeOf(typeof(DynamicsOptions));
+            Native.Check(Native.pose_set_dynamics_options(Handle, ref options));
+        }
+
+        /// <summary>Advance the soft tissue by dt seconds toward the posed skeleton (pose_step).</summary>
+        public void Step(double dt) { Native.Check(Native.pose_step(Handle, dt)); }
+        public void ResetDynamics() { Native.Check(Native.pose_reset_dynamics(Handle)); }
+
+        public DynamicsStats DynamicsStats()
+        {
+            var s = new DynamicsStats { Size = (UIntPtr)Marshal.SizeOf(typeof(DynamicsStats)) };
+            Native.Check(Native.pose_get_dynamics_stats(Handle, ref s));
+            return s;
+        }
 
         /// <summary>Posed positions of a tissue after Apply into `xyz` (3 per vertex; reuse it every frame).</summary>
         public int CopyPositions(int tissue, float[] xyz) { return Copy(Native.pose_tissue_positions, tissue, xyz); }

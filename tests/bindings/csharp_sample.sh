@@ -17,6 +17,7 @@ mcs -nologo -warnaserror -out:"$tmp/sample.exe" "$src/bindings/csharp/Pose.cs" "
 export LD_LIBRARY_PATH="$libdirs${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 mono "$tmp/sample.exe" "$1" "$tmp/csharp.bin" "${@:2}" | tee "$tmp/sample.log"
 grep -q "format 1; .* bent" "$tmp/sample.log"
+grep -Eq "^dynamics: (6 steps, 0\.0500 s simulated, [1-9][0-9]* islands|unsupported)" "$tmp/sample.log"
 "$helper" "$1" "$tmp/c.bin" "${@:2}"
 cmp "$tmp/csharp.bin" "$tmp/c.bin"
 if mono "$tmp/sample.exe" "$tmp/missing.rig" "$tmp/x.bin" 2>"$tmp/err.log"; then

@@ -97,6 +97,38 @@ class Bindings(unittest.TestCase):
             self.assertIn("clamped", pose.last_error())
         self.assertIsNone(rig._handle)  # the context manager closed it
 
+    def test_fem_and_dynamics(self):
+        with pose.Rig(RIG) as rig, pose.State(rig) as state:
+            joint = rig.joint_count // 2
+            state.set_joint_euler(joint, (0, 40, 0))
+            if not rig.has_fem:  # the synthetic bar
+                with self.assertRaises(pose.PoseError) as caught:
+                    state.step(1 / 120)
+                self.assertEqual(caught.exception.status, pose.Status.UNSUPPORTED)
+                return
+            state.method = pose.Method.FEM
+            self.assertEqual(state.method, pose.Method.FEM)
+            state.apply()
+            fem = state.fem_stats()
+            self.assertGreater(fem["outer_iterations"], 0)
+            self.assertLess(fem["residual"], 1.0)
+            with self.assertRaises(TypeError):
+                state.set_dynamics(no_such_option=1)
+            with self.assertRaises(pose.PoseError) as caught:
+                state.set_dynamics(tolerance=2.0)
+            self.assertEqual(caught.exception.status, pose.Status.INVALID_ARGUMENT)
+            state.set_dynamics(gravity=(0.0, 0.0, 0.0), cg_iterations=40)
+            state.reset_dynamics()
+            state.set_joint_euler(joint, (0, 60, 0))
+            for _ in range(6):
+                state.step(1 / 120)
+            stats = state.dynamics_stats()
+            self.assertAlmostEqual(stats["time"], 6 / 120, places=9)
+            self.assertGreater(stats["islands"], 0)
+            self.assertGreater(stats["kinetic_energy"], 0.0)  # the joint's step set the tissue moving
+            flat = memoryview(state.positions(0)).cast("B").cast("f").tolist()
+            self.assertTrue(all(abs(v) < 1e3 for v in flat))
+
     @unittest.skipUnless(CLIP, "no clip given (the bridge is not built)")
     def test_bridge_plays_the_clip(self):
         with pose.Rig(RIG) as rig, pose.State(rig) as state, \

@@ -41,6 +41,20 @@ class Sample
                                   + "posed height {9:F3}", args[0], rig.JointCount, rig.TissueCount, rig.FormatVersion,
                                   rig.Joint(joint).Name, clamped ? " (clamped)" : "", w.Translation[0],
                                   w.Translation[1], w.Translation[2], hi[2] - lo[2]);
+                // Soft tissue that swings after the joint: a host's fixed 120 Hz loop.
+                if (rig.HasFem) {
+                    Pose.DynamicsOptions dyn = Pose.DynamicsOptions.Defaults();
+                    dyn.CgIterations = 40;
+                    state.SetDynamics(dyn);
+                    state.SetJointEuler(joint, 10, 60, 0);
+                    for (int i = 0; i < 6; i++)
+                        state.Step(1.0 / 120);
+                    Pose.DynamicsStats s = state.DynamicsStats();
+                    Console.WriteLine("dynamics: 6 steps, {0:F4} s simulated, {1} islands, kinetic energy {2:E2} J",
+                                      s.Time, s.Islands, s.KineticEnergy);
+                } else {
+                    Console.WriteLine("dynamics: unsupported (the rig has no fem section)");
+                }
             }
         } catch (Pose.PoseException e) {
             Console.Error.WriteLine("sample: " + e.Message);

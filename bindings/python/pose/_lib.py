@@ -11,8 +11,8 @@ import ctypes
 import ctypes.util
 import os
 
-from ._types import (BridgeFrame, BridgeOptions, BridgeStatus, JointClinical, JointInfo, LoadOptions,
-                     StateOptions, TissueInfo, TetInfo, Transform)
+from ._types import (BridgeFrame, BridgeOptions, BridgeStatus, DynamicsOptions, DynamicsStats, FemStats,
+                     JointClinical, JointInfo, LoadOptions, StateOptions, TissueInfo, TetInfo, Transform)
 
 _here = os.path.dirname(os.path.abspath(__file__))
 
@@ -101,6 +101,13 @@ _declare(libpose, [
     ("pose_tet_positions", P(ctypes.c_float), [_state, P(_size)]),
     ("pose_joint_world", _status, [_state, _int, P(Transform)]),
     ("pose_state_bounds", _status, [_state, _int, c_float3, c_float3]),
+    ("pose_rig_has_fem", _int, [_rig]),
+    ("pose_get_fem_stats", _status, [_state, P(FemStats)]),
+    ("pose_dynamics_defaults", None, [P(DynamicsOptions)]),
+    ("pose_set_dynamics_options", _status, [_state, P(DynamicsOptions)]),
+    ("pose_step", _status, [_state, ctypes.c_double]),
+    ("pose_reset_dynamics", _status, [_state]),
+    ("pose_get_dynamics_stats", _status, [_state, P(DynamicsStats)]),
 ])
 
 _libbridge = None

@@ -71,3 +71,23 @@ class BridgeStatus(ctypes.Structure):
                 ("duration_s", ctypes.c_double), ("lag_p50_ms", ctypes.c_double), ("lag_p99_ms", ctypes.c_double),
                 ("lag_max_ms", ctypes.c_double), ("realtime", ctypes.c_int), ("frame", ctypes.c_long),
                 ("frame_count", ctypes.c_long), ("frame_time_s", ctypes.c_double), ("fault", ctypes.c_char * 256)]
+
+
+class FemStats(ctypes.Structure):
+    _fields_ = [("size", ctypes.c_size_t), ("outer_iterations", ctypes.c_int), ("cg_iterations", ctypes.c_int),
+                ("residual", ctypes.c_double), ("seconds_skin", ctypes.c_double),
+                ("seconds_rotations", ctypes.c_double), ("seconds_cg", ctypes.c_double),
+                ("seconds_transfer", ctypes.c_double)]
+
+
+class DynamicsOptions(ctypes.Structure):
+    _fields_ = [("size", ctypes.c_size_t), ("mass_damping", ctypes.c_float), ("stiffness_damping", ctypes.c_float),
+                ("gravity", _f3), ("coupling_stiffness", ctypes.c_float), ("tolerance", ctypes.c_float),
+                ("cg_iterations", ctypes.c_int)]
+
+
+class DynamicsStats(ctypes.Structure):
+    _fields_ = [("size", ctypes.c_size_t), ("islands", ctypes.c_int), ("cg_iterations", ctypes.c_int),
+                ("residual", ctypes.c_double), ("kinetic_energy", ctypes.c_double), ("time", ctypes.c_double),
+                ("seconds_skin", ctypes.c_double), ("seconds_assembly", ctypes.c_double),
+                ("seconds_cg", ctypes.c_double), ("seconds_transfer", ctypes.c_double)]

@@ -134,6 +134,11 @@ class Rig:
         return tuple(lo), tuple(hi)
 
     @property
+    def has_fem(self):
+        """Whether the rig has what Method.FEM and State.step() need (its fem section)."""
+        return bool(libpose.pose_rig_has_fem(self.handle))
+
+    @property
     def metadata(self):
         return libpose.pose_rig_metadata(self.handle).decode(errors="replace")
 

@@ -5,7 +5,7 @@ import enum
 
 from . import _views
 from ._lib import c_float3, c_float4, libpose
-from ._types import StateOptions, Transform
+from ._types import DynamicsOptions, DynamicsStats, FemStats, StateOptions, Transform
 from .errors import PoseError, Status, check
 
 
@@ -13,6 +13,7 @@ class Method(enum.IntEnum):
     LBS = 0
     DQS = 1
     COR = 2
+    FEM = 3  # CoR refined to quasi-static co-rotational elasticity (rigs with a fem section)
 
 
 class EulerOrder(enum.IntEnum):
@@ -105,6 +106,39 @@ class State:
     def apply(self):
         """pose_apply: forward kinematics, skinning, every tissue vertex and normal."""
         check(libpose.pose_apply(self.handle))
+
+    def fem_stats(self):
+        """What the last apply() with Method.FEM did (pose_fem_stats as a dict)."""
+        s = FemStats(size=ctypes.sizeof(FemStats))
+        check(libpose.pose_get_fem_stats(self.handle, ctypes.byref(s)))
+        return {name: getattr(s, name) for name, _ in FemStats._fields_ if name != "size"}
+
+    # ---- dynamics (rigs with a fem section and massive soft tissue)
+    def set_dynamics(self, **options):
+        """pose_set_dynamics_options from the defaults, with keyword overrides
+        (mass_damping, stiffness_damping, gravity, coupling_stiffness, tolerance,
+        cg_iterations)."""
+        o = DynamicsOptions()
+        libpose.pose_dynamics_defaults(ctypes.byref(o))
+        for name, value in options.items():
+            if name == "size" or name not in dict(DynamicsOptions._fields_):
+                raise TypeError("unknown dynamics option %r" % name)
+            setattr(o, name, (ctypes.c_float * 3)(*value) if name == "gravity" else value)
+        check(libpose.pose_set_dynamics_options(self.handle, ctypes.byref(o)))
+
+    def step(self, dt):
+        """pose_step: advance the soft tissue by dt seconds toward the posed skeleton."""
+        check(libpose.pose_step(self.handle, dt))
+
+    def reset_dynamics(self):
+        """Restart the simulation at rest in the current skinned pose."""
+        check(libpose.pose_reset_dynamics(self.handle))
+
+    def dynamics_stats(self):
+        """What the last step() did (pose_dynamics_stats as a dict)."""
+        s = DynamicsStats(size=ctypes.sizeof(DynamicsStats))
+        check(libpose.pose_get_dynamics_stats(self.handle, ctypes.byref(s)))
+        return {name: getattr(s, name) for name, _ in DynamicsStats._fields_ if name != "size"}
 
     # ---- results (views of the state's memory, rewritten by apply())
     def _tissue_array(self, fn, tissue):
