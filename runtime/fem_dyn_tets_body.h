@@ -103,9 +103,18 @@ static POSE__INLINE void blocks8(const pose__fem_dyn_tets *t, const pose__v8f R[
 /* The block's corner values of a per-vertex field (3 floats per vertex). */
 static POSE__INLINE void gather8(const pose__fem_dyn_tets *t, const float *u, pose__v8f out[4][3])
 {
+#ifdef __AVX2__
+    for (int k = 0; k < 4; k++) {
+        const __m256i i = _mm256_loadu_si256((const __m256i *)(const void *)t->v[k]);
+        const __m256i i3 = _mm256_add_epi32(_mm256_add_epi32(i, i), i);
+        for (int a = 0; a < 3; a++)
+            out[k][a] = (pose__v8f)_mm256_i32gather_ps(u + a, i3, 4);
+    }
+#else
     for (int k = 0; k < 4; k++)
         for (int a = 0; a < 3; a++)
             out[k][a] = V8_GATHER(u, t->v[k], 3, a);
+#endif
 }
 
 void POSE__KV(pose__fem_dyn_rotate)(const pose__fem_dyn_tets *tets, pose__fem_dyn_rot *rot,

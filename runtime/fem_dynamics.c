@@ -296,6 +296,12 @@ static inline float spring_of(const step_ctx *c, size_t v)
     return c->mesh->inv_diag[v] == 0.0f ? c->prm->coupling * c->d->stiff[v] : 0.0f;
 }
 
+/* A vertex's dot product in double (the passes sum them in double). */
+static inline double dot3(const float *a, const float *b)
+{
+    return (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2];
+}
+
 /* The warm start's residual r = b - A v, b = M v + dt f, with f every
  * force at x but the damping (the spring pulls toward the bone where it is
  * at the end of the step, its damping acts on the velocity relative to the
@@ -337,13 +343,11 @@ static void residual_vertex(const step_ctx *c, size_t v, float vp, double sum[PO
     pose__fem_apply_block(pre, bv, pb);
     pose__fem_apply_block(pre, r, u);
     const float dd = c->mscale * mass + c->kscale * ks;
-    for (int a = 0; a < 3; a++) {
-        sum[0] += (double)r[a] * u[a];
-        sum[1] += (double)r[a] * r[a];
-        sum[2] += (double)bv[a] * pb[a];
-        sum[3] += (double)u[a] * (dd * u[a]);
-        sum[4] += (double)gv[a] * u[a];
-    }
+    sum[0] += dot3(r, u);
+    sum[1] += dot3(r, r);
+    sum[2] += dot3(bv, pb);
+    sum[3] += dd * dot3(u, u);
+    sum[4] += dot3(gv, u);
 }
 
 /* One Chronopoulos-Gear CG iteration at a vertex: w = A u (the gathered
@@ -369,12 +373,10 @@ static void update_vertex(const step_ctx *c, size_t v, float alpha, float beta, 
         r[a] -= alpha * sv[a];
     }
     pose__fem_apply_block(w->pre + 6 * v, r, u);
-    for (int a = 0; a < 3; a++) {
-        sum[0] += (double)r[a] * u[a];
-        sum[1] += (double)r[a] * r[a];
-        sum[3] += (double)u[a] * (dd * u[a]);
-        sum[4] += (double)gv[a] * u[a];
-    }
+    sum[0] += dot3(r, u);
+    sum[1] += dot3(r, r);
+    sum[3] += dd * dot3(u, u);
+    sum[4] += dot3(gv, u);
 }
 
 /* A vertex pass over segment s (vertices [seg_first[s], e) of its island). */
