@@ -187,18 +187,23 @@ static bend bend_and_hold(const char *const *names, int n, int hold_steps, int u
                 break;
         }
     }
+    char settled[64];
+    if (r.settled_s >= 0.0)
+        snprintf(settled, sizeof settled, "%.3f s after the stop", r.settled_s);
+    else
+        snprintf(settled, sizeof settled, "not within %.2f s", hold_steps * DT);
     printf("%s %s%s: kinetic energy peak %.3g J, %.3g J (%.2g of it) at the end; below 1e-6 of it "
-           "%.3f s after the stop (-1: not within %.2f s); tissue within %.1f mm of the skinned "
-           "pose; bone tissues within %.4f mm of their rigid motion; at most %d CG iterations\n",
+           "%s; tissue within %.1f mm of the skinned pose; bone tissues within %.4f mm of their "
+           "rigid motion; at most %d CG iterations\n",
            names[0], names[1], n > 2 ? " and the elbows" : "", r.peak, r.ke_end, r.ke_end / r.peak,
-           r.settled_s, hold_steps * DT, r.lag * 1e3, r.bones * 1e3, r.cg_max);
+           settled, r.lag * 1e3, r.bones * 1e3, r.cg_max);
     pose_state_free(skinned);
     pose_state_free(st);
     return r;
 }
 
 /* Elbows bent 0 -> 90 degrees at 360 deg/s, then held: the tissue settles
- * (kinetic energy below 1e-6 of its peak) within 1 s of the stop (0.44 s
+ * (kinetic energy below 1e-6 of its peak) within 1 s of the stop (0.28 s
  * measured), bones rigid, no vertex farther than 20 cm from the skinned
  * pose. The soft tissue is soft (a few kPa): the forearm's trails the bone
  * by 13.7 cm in the swing, and the elbow's crease ends 5.2 cm from where
