@@ -19,6 +19,7 @@
 #include "fem_box.h"
 #include "fem_dynamics.h"
 #include "pose/pose.h"
+#include "rt_skin.h" /* pose__kernels_force_generic, pose__kernels_variant */
 
 typedef struct dyn_sim {
     sim s;
@@ -341,27 +342,35 @@ static void test_swing_dt_30(void **state)
     swing(1.0 / 30.0);
 }
 
-/* 1 and 2 threads: the same bits, step after step; no allocation after
- * the first step. */
+/* 1 and 2 threads, and the generic kernels against the AVX2 ones where the
+ * CPU has them: the same bits, step after step; no allocation after the
+ * first step. */
 static void test_threads_and_allocation(void **state)
 {
     (void)state;
     box b;
     pose_rig *rig = limb_rig(&b, 1000.0f);
     assert_non_null(rig);
-    pose_state *one = limb_state(rig, 1), *two = limb_state(rig, 2);
+    pose_state *one = limb_state(rig, 1), *two = limb_state(rig, 2), *generic = limb_state(rig, 1);
     pose_dynamics_options o;
     pose_dynamics_defaults(&o);
     o.gravity[2] = -9.81f;
     assert_int_equal(pose_set_dynamics_options(one, &o), POSE_OK);
     assert_int_equal(pose_set_dynamics_options(two, &o), POSE_OK);
+    assert_int_equal(pose_set_dynamics_options(generic, &o), POSE_OK);
     const size_t allocs = g_allocs;
     for (int s = 1; s <= 40; s++) {
         bend(one, 2.0 * s);
         bend(two, 2.0 * s);
+        bend(generic, 2.0 * s);
         assert_int_equal(pose_step(one, 1.0 / 120.0), POSE_OK);
         assert_int_equal(pose_step(two, 1.0 / 120.0), POSE_OK);
+        pose__kernels_force_generic(1);
+        assert_int_equal(pose_step(generic, 1.0 / 120.0), POSE_OK);
+        pose__kernels_force_generic(0);
         assert_memory_equal(pose_tet_positions(one, NULL), pose_tet_positions(two, NULL),
+                            3 * b.nv * sizeof(float));
+        assert_memory_equal(pose_tet_positions(one, NULL), pose_tet_positions(generic, NULL),
                             3 * b.nv * sizeof(float));
     }
     assert_int_equal(g_allocs, allocs);
@@ -369,8 +378,10 @@ static void test_threads_and_allocation(void **state)
     pose_get_dynamics_stats(one, &a);
     pose_get_dynamics_stats(two, &c);
     assert_true(a.kinetic_energy == c.kinetic_energy && a.cg_iterations == c.cg_iterations);
-    printf("1 and 2 threads: identical over 40 steps (kinetic %.4e J, CG %d); no allocation\n",
-           a.kinetic_energy, a.cg_iterations);
+    printf("1 and 2 threads, %s and generic kernels: identical over 40 steps (kinetic %.4e J, "
+           "CG %d); no allocation\n",
+           pose__kernels_variant(), a.kinetic_energy, a.cg_iterations);
+    pose_state_free(generic);
     pose_state_free(one);
     pose_state_free(two);
     pose_rig_free(rig);
