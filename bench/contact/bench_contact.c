@@ -10,7 +10,9 @@
  * Then the response (pose_set_contact_response): pose_apply with it off
  * and on, per frame, on 1 and 2 threads: the difference is what the push
  * adds.
- * Usage: bench_contact RIG [--seconds S]   (S per pose and thread count, default 1)
+ * Usage: bench_contact RIG [--seconds S] [--response-only]
+ *   (S per pose and thread count, default 1; --response-only skips the
+ *   detection's timing)
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -34,6 +36,16 @@ static void time_apply(pose_state *st, double seconds, double *wall, double *cpu
     *cpu = (bench_cpu_seconds() - c0) / frames;
 }
 
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Blocks of frames with the response off and on, interleaved, so that both
+ * see the same load on a shared machine; min and median per frame. */
+#define BLOCKS 7
+
 static int bench_response(pose_rig *rig, double seconds)
 {
     for (int threads = 1; threads <= 2; threads++) {
@@ -48,19 +60,29 @@ static int bench_response(pose_rig *rig, double seconds)
         if (pose_set_contact_response(st, &on) != POSE_OK)
             return 1;
         pose_get_contact_response_stats(st, &rs);
-        printf("response, DQS, %d thread%s (built in %.0f ms)\n", threads, threads > 1 ? "s" : "",
-               1e3 * rs.build_seconds);
+        printf("response, DQS, %d thread%s (built in %.0f ms); CPU per thread per frame, min/median of %d "
+               "interleaved blocks\n", threads, threads > 1 ? "s" : "", 1e3 * rs.build_seconds, BLOCKS);
         for (size_t p = 0; p < CONTACT_POSE_COUNT; p++) {
-            double w_off, c_off, w_on, c_on;
+            double w_off[BLOCKS], c_off[BLOCKS], w_on[BLOCKS], c_on[BLOCKS], add[BLOCKS];
             contact_pose_set(rig, st, &contact_poses[p]);
-            pose_set_contact_response(st, &off);
-            time_apply(st, seconds, &w_off, &c_off);
-            pose_set_contact_response(st, &on);
-            time_apply(st, seconds, &w_on, &c_on);
+            for (int b = 0; b < BLOCKS; b++) {
+                pose_set_contact_response(st, &off);
+                time_apply(st, seconds / BLOCKS, &w_off[b], &c_off[b]);
+                pose_set_contact_response(st, &on);
+                time_apply(st, seconds / BLOCKS, &w_on[b], &c_on[b]);
+                add[b] = c_on[b] - c_off[b];
+            }
             pose_get_contact_response_stats(st, &rs);
-            printf("  %-18s: pose_apply %6.2f -> %6.2f ms CPU per thread per frame (+%.2f; wall %.2f -> %.2f); "
-                   "%zu skin vertices pushed\n", contact_poses[p].label, 1e3 * c_off / threads, 1e3 * c_on / threads,
-                   1e3 * (c_on - c_off) / threads, 1e3 * w_off, 1e3 * w_on, rs.pushed);
+            qsort(c_off, BLOCKS, sizeof(double), cmp_double);
+            qsort(c_on, BLOCKS, sizeof(double), cmp_double);
+            qsort(add, BLOCKS, sizeof(double), cmp_double);
+            qsort(w_off, BLOCKS, sizeof(double), cmp_double);
+            qsort(w_on, BLOCKS, sizeof(double), cmp_double);
+            const double k = 1e3 / threads;
+            printf("  %-18s: pose_apply off %5.2f/%5.2f, on %5.2f/%5.2f ms; added %5.2f/%5.2f ms (wall median "
+                   "%.2f -> %.2f); %zu skin vertices pushed\n", contact_poses[p].label, k * c_off[0],
+                   k * c_off[BLOCKS / 2], k * c_on[0], k * c_on[BLOCKS / 2], k * (c_on[0] - c_off[0]),
+                   k * add[BLOCKS / 2], 1e3 * w_off[BLOCKS / 2], 1e3 * w_on[BLOCKS / 2], rs.pushed);
         }
         pose_state_free(st);
     }
@@ -70,19 +92,28 @@ static int bench_response(pose_rig *rig, double seconds)
 int main(int argc, char **argv)
 {
     if (argc < 2) {
-        fprintf(stderr, "usage: %s RIG [--seconds S]\n", argv[0]);
+        fprintf(stderr, "usage: %s RIG [--seconds S] [--response-only]\n", argv[0]);
         return 2;
     }
     double seconds = 1.0;
-    if (argc > 3 && strcmp(argv[2], "--seconds") == 0)
-        seconds = atof(argv[3]);
+    int detection = 1;
+    for (int i = 2; i < argc; i++) {
+        if (strcmp(argv[i], "--seconds") == 0 && i + 1 < argc)
+            seconds = atof(argv[++i]);
+        else if (strcmp(argv[i], "--response-only") == 0)
+            detection = 0;
+        else {
+            fprintf(stderr, "usage: %s RIG [--seconds S] [--response-only]\n", argv[0]);
+            return 2;
+        }
+    }
     pose_rig *rig;
     pose_state *st;
     if (pose_rig_load(argv[1], &rig) != POSE_OK || pose_state_create(rig, &st) != POSE_OK) {
         fprintf(stderr, "%s\n", pose_last_error());
         return 1;
     }
-    for (int threads = 1; threads <= 2; threads++) {
+    for (int threads = 1; threads <= 2 && detection; threads++) {
         pose_contact_options o = {.size = sizeof o, .threads = threads};
         pose_contact *c;
         const double t0 = bench_now();

@@ -44,14 +44,24 @@ static int in_box(const pose__push_bone *b, const float *q, float pad)
            q[0] < b->hi[0] + pad && q[1] < b->hi[1] + pad && q[2] < b->hi[2] + pad;
 }
 
-static uint8_t cell_state(const pose__push_bone *b, const float *q)
+/* q's cell, clamped to the grid, and its brick. */
+static inline size_t brick_of(const pose__push_bone *b, const float *q, int *i)
 {
-    size_t i[3];
     for (int d = 0; d < 3; d++) {
-        const int c = (int)((q[d] - b->lo[d]) / b->cell);
-        i[d] = (size_t)(c < 0 ? 0 : c >= b->dim[d] ? b->dim[d] - 1 : c);
+        const float e = (q[d] - b->lo[d]) * b->inv_cell;
+        const int c = e <= 0.0f ? 0 : e >= (float)b->dim[d] ? b->dim[d] - 1 : (int)e;
+        i[d] = c >= b->dim[d] ? b->dim[d] - 1 : c;
     }
-    return b->cells[(i[2] * (size_t)b->dim[1] + i[1]) * (size_t)b->dim[0] + i[0]];
+    return ((size_t)(i[2] >> 2) * (size_t)b->bricks[1] + (size_t)(i[1] >> 2)) * (size_t)b->bricks[0] +
+           (size_t)(i[0] >> 2);
+}
+
+/* The grid's code (contact_push.h) at q's cell. */
+static inline uint8_t grid_code(const pose__push_bone *b, const float *q)
+{
+    int i[3];
+    const size_t brick = brick_of(b, q, i);
+    return b->grid[64 * brick + (size_t)((i[2] & 3) << 4 | (i[1] & 3) << 2 | (i[0] & 3))];
 }
 
 /* Push x (posed) out of bone b (frame f) to the margin; the move's length,
@@ -62,17 +72,25 @@ static float push_vertex(const pose__push *p, const pose__push_bone *b, const fl
     to_rest(f, x, q);
     if (!in_box(b, q, 0.0f))
         return 0.0f;
-    const uint8_t state = cell_state(b, q);
-    if (state == POSE__CELL_OUT)
+    const uint8_t code = grid_code(b, q);
+    if (code >= POSE__CELL_OUT)
         return 0.0f;
-    /* A point of a NEAR cell is searched within the margin and a cell,
-     * where the surface nearly always is (a hit within a shorter reach is
-     * the nearest). Nothing there: outside, it is farther than the margin
-     * and stays; inside (a ray says so), it searches on, as one of an IN
-     * cell does. */
-    const float near = p->margin + 1.7320508f * b->cell;
+    /* A point of a NEAR_OUT cell is outside: only a triangle within the
+     * margin matters. One of a SURF or NEAR cell has a triangle within
+     * sqrt(3) (cell + margin) (contact_push_build.c), so the search within
+     * that reach finds the nearest (a hit within a shorter reach is the
+     * nearest). Nothing there (rounding): outside, it is farther than the
+     * margin and stays; inside (a ray says so), it searches on, as one of
+     * an IN cell does. */
+    const float near = 1.7320508f * (b->cell + p->margin) * 1.001f;
     float c[3], out[3];
-    float sd = pose__push_distance(b, q, state == POSE__CELL_NEAR ? near : INFINITY, c, out);
+    float sd = pose__push_distance(b, q,
+                                   code == POSE__CELL_NEAR_OUT ? p->margin
+                                   : code == POSE__CELL_IN     ? INFINITY
+                                                               : near,
+                                   c, out);
+    if (isinf(sd) && code == POSE__CELL_NEAR_OUT)
+        return 0.0f;
     if (isinf(sd)) {
         if (pose__bvh_winding_along(&b->tree, b->rest, q, f) <= 0)
             return 0.0f;
@@ -99,55 +117,92 @@ static float push_vertex(const pose__push *p, const pose__push_bone *b, const fl
     return sqrtf(moved);
 }
 
-/* Clusters split by part: each vertex is moved by one part, bone after bone
- * in the rig's order, so any thread count gives the same bits. */
-void pose__state_push_task(void *ctx, unsigned part, unsigned parts)
+/* Bounding sphere (the box's centre and half diagonal) of skin entries
+ * [vb, ve). */
+static void sphere_of(const pose_state *st, const uint32_t *order, size_t vb, size_t ve, float *sphere)
+{
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = vb; i < ve; i++)
+        for (int d = 0; d < 3; d++) {
+            const float x = st->tissue_positions[3 * (size_t)order[i] + (size_t)d];
+            lo[d] = x < lo[d] ? x : lo[d];
+            hi[d] = x > hi[d] ? x : hi[d];
+        }
+    for (int d = 0; d < 3; d++)
+        sphere[d] = 0.5f * (lo[d] + hi[d]);
+    sphere[3] = 0.5f * sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                             (hi[2] - lo[2]) * (hi[2] - lo[2]));
+}
+
+/* A sphere (posed) can hold a point that bone b (frame f) needs tested: in
+ * the grid's box, and not all in OUT cells (its centre's cell more than
+ * radius + a cell from any non-OUT one: the gap, or its brick's least,
+ * which reads a smaller map, when not `fine`). */
+static int sphere_near_bone(const pose__push_bone *b, const float *f, const float *sphere, int fine)
+{
+    float q[3];
+    to_rest(f, sphere, q);
+    if (!in_box(b, q, sphere[3]))
+        return 0;
+    int i[3];
+    const size_t brick = brick_of(b, q, i);
+    const uint8_t code = b->grid[64 * brick + (size_t)((i[2] & 3) << 4 | (i[1] & 3) << 2 | (i[0] & 3))];
+    const int gap = fine ? (code >= POSE__CELL_OUT ? code - (POSE__CELL_OUT - 1) : 0) : b->brick_gap[brick];
+    return !(gap > 1 && ((float)gap - 1.0f) * b->cell > sphere[3] * 1.001f + 1e-6f);
+}
+
+/* Clusters split into items: each vertex is moved by one item, bone after
+ * bone in the rig's order, and each item writes its own counts, so any
+ * thread count and any assignment of items give the same bits. A cluster
+ * is tested against a bone's sphere, box and grid, then its groups of
+ * POSE__PUSH_GROUP against box and grid, then their vertices. */
+void pose__state_push_item(void *ctx, size_t item)
 {
     pose_state *st = ctx;
     pose__push *p = st->push;
     size_t pushed = 0;
     float most = 0.0f;
-    const size_t cb = pose__part_begin(p->cluster_count, part, parts),
-                 ce = pose__part_begin(p->cluster_count, part + 1, parts);
+    enum { GROUPS = POSE__PUSH_CLUSTER / POSE__PUSH_GROUP };
+    const size_t cb = pose__part_begin(p->cluster_count, (unsigned)item, POSE__PUSH_ITEMS),
+                 ce = pose__part_begin(p->cluster_count, (unsigned)item + 1, POSE__PUSH_ITEMS);
     for (size_t c = cb; c < ce; c++) {
         const size_t vb = c * POSE__PUSH_CLUSTER,
                      ve = vb + POSE__PUSH_CLUSTER < p->vertex_count ? vb + POSE__PUSH_CLUSTER : p->vertex_count;
-        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (size_t i = vb; i < ve; i++)
-            for (int d = 0; d < 3; d++) {
-                const float x = st->tissue_positions[3 * (size_t)p->order[i] + (size_t)d];
-                lo[d] = x < lo[d] ? x : lo[d];
-                hi[d] = x > hi[d] ? x : hi[d];
-            }
-        const float center[3] = {0.5f * (lo[0] + hi[0]), 0.5f * (lo[1] + hi[1]), 0.5f * (lo[2] + hi[2])};
-        const float radius = 0.5f * sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                          (hi[2] - lo[2]) * (hi[2] - lo[2]));
+        float cluster[4], group[GROUPS][4];
+        sphere_of(st, p->order, vb, ve, cluster);
+        const size_t groups = (ve - vb + POSE__PUSH_GROUP - 1) / POSE__PUSH_GROUP;
+        for (size_t g = 0; g < groups; g++) {
+            const size_t gb = vb + g * POSE__PUSH_GROUP;
+            sphere_of(st, p->order, gb, gb + POSE__PUSH_GROUP < ve ? gb + POSE__PUSH_GROUP : ve, group[g]);
+        }
         /* One push per vertex per frame: a vertex pushed out of one bone into
-         * another stays there rather than move by more than its depth. */
+         * another stays there rather than move by more than its depth. (A
+         * vertex not yet pushed has not moved: the spheres hold it.) */
         uint8_t done[POSE__PUSH_CLUSTER] = {0};
         for (size_t j = 0; j < p->bone_count; j++) {
             const pose__push_bone *b = &p->bones[j];
             const float *s = p->bone_spheres + 4 * j, *f = p->frames + 12 * j;
-            const float dx = center[0] - s[0], dy = center[1] - s[1], dz = center[2] - s[2];
-            const float reach = radius + s[3] + p->margin;
-            if (dx * dx + dy * dy + dz * dz > reach * reach)
+            const float dx = cluster[0] - s[0], dy = cluster[1] - s[1], dz = cluster[2] - s[2];
+            const float reach = cluster[3] + s[3] + p->margin;
+            if (dx * dx + dy * dy + dz * dz > reach * reach || !sphere_near_bone(b, f, cluster, 0))
                 continue;
-            float q[3];
-            to_rest(f, center, q);
-            if (!in_box(b, q, radius))
-                continue;
-            for (size_t i = vb; i < ve; i++) {
-                if (p->skip[i] || done[i - vb])
+            for (size_t g = 0; g < groups; g++) {
+                if (!sphere_near_bone(b, f, group[g], 1))
                     continue;
-                const float m = push_vertex(p, b, f, st->tissue_positions + 3 * (size_t)p->order[i]);
-                done[i - vb] = m > 0.0f;
-                pushed += m > 0.0f;
-                most = m > most ? m : most;
+                const size_t gb = vb + g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < ve ? gb + POSE__PUSH_GROUP : ve;
+                for (size_t i = gb; i < ge; i++) {
+                    if (p->skip[i] || done[i - vb])
+                        continue;
+                    const float m = push_vertex(p, b, f, st->tissue_positions + 3 * (size_t)p->order[i]);
+                    done[i - vb] = m > 0.0f;
+                    pushed += m > 0.0f;
+                    most = m > most ? m : most;
+                }
             }
         }
     }
-    p->pushed[part] = pushed;
-    p->max_push[part] = most;
+    p->pushed[item] = pushed;
+    p->max_push[item] = most;
 }
 
 void pose__state_push(pose_state *st)
@@ -158,7 +213,7 @@ void pose__state_push(pose_state *st)
     memset(st->push->pushed, 0, sizeof st->push->pushed);
     memset(st->push->max_push, 0, sizeof st->push->max_push);
     pose__state_push_frames(st);
-    pose__pool_run(st->pool, pose__state_push_task, st);
+    pose__pool_run_items(st->pool, pose__state_push_item, st, POSE__PUSH_ITEMS);
     st->push_seconds = pose__seconds() - t0;
 }
 

@@ -22,12 +22,20 @@
 
 /** Skin vertices per cluster. */
 #define POSE__PUSH_CLUSTER 32
+/** Skin vertices per group (a cluster's part, tested before its vertices). */
+#define POSE__PUSH_GROUP 4
+/** Items of the pass (runs of clusters; pose__pool_run_items gives them to
+ *  whichever thread is free: the work gathers where skin lies on bone). */
+#define POSE__PUSH_ITEMS 128
 
-/** Grid cell states. */
+
+/** Grid cell states (pose__push_bone.grid codes OUT cells with their gap). */
 enum {
-    POSE__CELL_OUT = 0,  /**< every point farther than the margin outside */
-    POSE__CELL_NEAR = 1, /**< a triangle's box, grown by the margin, touches it */
-    POSE__CELL_IN = 2,   /**< every point inside, deeper than the margin */
+    POSE__CELL_IN = 0,       /**< every point inside, deeper than the margin */
+    POSE__CELL_NEAR_IN = 1,  /**< inside; a triangle touches the cell grown by the margin */
+    POSE__CELL_SURF = 2,     /**< a triangle crosses the cell */
+    POSE__CELL_NEAR_OUT = 3, /**< outside; a triangle touches the cell grown by the margin */
+    POSE__CELL_OUT = 4,      /**< every point farther than the margin outside */
 };
 
 typedef struct pose__push_bone {
@@ -40,8 +48,16 @@ typedef struct pose__push_bone {
     float center[3], radius; /**< bounding sphere at rest */
     float lo[3], hi[3];  /**< the grid's box at rest */
     float cell;          /**< grid spacing */
+    float inv_cell;      /**< 1 / cell */
     int dim[3];
-    uint8_t *cells;      /**< POSE__CELL_* per cell, x fastest */
+    int bricks[3];       /**< bricks of 4 x 4 x 4 cells per axis */
+    uint8_t *grid;       /**< per cell, brick by brick (64 bytes each, x fastest
+                              within and across bricks): its POSE__CELL_* state, or for
+                              an OUT cell POSE__CELL_OUT - 1 + gap, where gap (>= 1,
+                              capped) is the Chebyshev distance in cells to the nearest
+                              cell that is not OUT */
+    uint8_t *brick_gap;  /**< per brick, the least gap of its cells (0 when one is not OUT):
+                              the clusters' test reads this small map, not the grid */
 } pose__push_bone;
 
 typedef struct pose__push {
@@ -54,8 +70,8 @@ typedef struct pose__push {
     size_t vertex_count, cluster_count;
     float *frames;          /**< per bone per frame: rotation (9, row-major) and translation */
     float *bone_spheres;    /**< per bone per frame: posed centre and radius */
-    size_t pushed[256];     /**< per part of the last pass (POSE__MAX_THREADS parts) */
-    float max_push[256];
+    size_t pushed[POSE__PUSH_ITEMS]; /**< per item of the last pass */
+    float max_push[POSE__PUSH_ITEMS];
     double build_seconds;
 } pose__push;
 
@@ -73,10 +89,10 @@ float pose__push_distance(const pose__push_bone *b, const float *q, float max_di
                           float *outward);
 
 /** pose_apply's last pass when the response is on: the bones' frames for
- *  the pose (serial, cheap), then the skin pushed, split by part. */
+ *  the pose (serial, cheap), then the skin pushed, item by item. */
 void pose__state_push(struct pose_state *st);
 void pose__state_push_frames(struct pose_state *st);
-void pose__state_push_task(void *ctx, unsigned part, unsigned parts);
+void pose__state_push_item(void *ctx, size_t item);
 /** pose_state_free: what pose_set_contact_response built. */
 void pose__state_push_free(struct pose_state *st);
 

@@ -131,12 +131,125 @@ float pose__push_distance(const pose__push_bone *b, const float *q, float max_di
     return side >= 0.0f ? d : -d;
 }
 
-/* The bone's sphere and grid. Cells that a triangle's box, grown by the
- * margin, touches are NEAR; the other cells reachable from the grid's
- * border through non-NEAR cells are OUT (a flood fill), the rest IN. No
- * point of an OUT cell is inside or within the margin. (Where a bone's mesh is
- * open the fill leaks in and its inside reads OUT: such points are not
- * pushed.) */
+/* Triangle abc overlaps the cube of centre c and half side h: no
+ * separating axis among the cube's 3, the triangle's normal and the 9
+ * edge x axis products (Akenine-Moller 2001), in double. */
+static int tri_box_overlap(const double *c, double h, const float *a, const float *b, const float *d)
+{
+    double v[3][3], e[3][3];
+    for (int k = 0; k < 3; k++) {
+        v[0][k] = (double)a[k] - c[k];
+        v[1][k] = (double)b[k] - c[k];
+        v[2][k] = (double)d[k] - c[k];
+    }
+    for (int k = 0; k < 3; k++) {
+        const double lo = fmin(fmin(v[0][k], v[1][k]), v[2][k]), hi = fmax(fmax(v[0][k], v[1][k]), v[2][k]);
+        if (lo > h || hi < -h)
+            return 0;
+    }
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < 3; i++)
+            e[k][i] = v[(k + 1) % 3][i] - v[k][i];
+    const double n[3] = {e[0][1] * e[1][2] - e[0][2] * e[1][1], e[0][2] * e[1][0] - e[0][0] * e[1][2],
+                         e[0][0] * e[1][1] - e[0][1] * e[1][0]};
+    const double dn = n[0] * v[0][0] + n[1] * v[0][1] + n[2] * v[0][2];
+    if (fabs(dn) > h * (fabs(n[0]) + fabs(n[1]) + fabs(n[2])))
+        return 0;
+    for (int k = 0; k < 3; k++)      /* edge */
+        for (int ax = 0; ax < 3; ax++) { /* cube axis: edge x axis */
+            double m[3] = {0.0, 0.0, 0.0};
+            m[(ax + 1) % 3] = e[k][(ax + 2) % 3];
+            m[(ax + 2) % 3] = -e[k][(ax + 1) % 3];
+            double lo = INFINITY, hi = -INFINITY;
+            for (int i = 0; i < 3; i++) {
+                const double p = m[0] * v[i][0] + m[1] * v[i][1] + m[2] * v[i][2];
+                lo = fmin(lo, p);
+                hi = fmax(hi, p);
+            }
+            const double r = h * (fabs(m[0]) + fabs(m[1]) + fabs(m[2]));
+            if (lo > r || hi < -r)
+                return 0;
+        }
+    return 1;
+}
+
+/* The runtime grid: per cell its state and, for an OUT cell, the Chebyshev
+ * distance (in cells, capped at 254) to the nearest cell that is not OUT:
+ * a breadth-first search over the 26 neighbours from those cells. A point
+ * of a cell with gap k is farther than (k - 1) cells from any point of a
+ * non-OUT cell, so a cluster of skin whose sphere is smaller than that has
+ * no vertex to test. Stored in bricks of 4 x 4 x 4 cells (one cache line):
+ * a cluster's vertices read a few lines instead of a line per row. */
+static pose_status bone_gap(pose__push_bone *b, const uint8_t *cells, uint32_t *queue, const pose_allocator *a)
+{
+    const size_t sy = (size_t)b->dim[0], sz = (size_t)b->dim[0] * (size_t)b->dim[1];
+    const size_t cells_n = sz * (size_t)b->dim[2];
+    uint8_t *code = pose__alloc(a, cells_n, POSE__ALIGN);
+    size_t bricks = 1;
+    for (int d = 0; d < 3; d++) {
+        b->bricks[d] = (b->dim[d] + 3) / 4;
+        bricks *= (size_t)b->bricks[d];
+    }
+    b->grid = pose__alloc(a, 64 * bricks, POSE__ALIGN);
+    b->brick_gap = pose__alloc(a, bricks, POSE__ALIGN);
+    if (!code || !b->grid || !b->brick_gap) {
+        pose__free(a, code);
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for a bone grid of %zu cells", cells_n);
+    }
+    size_t head = 0, tail = 0;
+    for (size_t i = 0; i < cells_n; i++) {
+        code[i] = cells[i] == POSE__CELL_OUT ? 255 : cells[i];
+        if (cells[i] != POSE__CELL_OUT)
+            queue[tail++] = (uint32_t)i;
+    }
+    while (head < tail) {
+        const size_t i = queue[head++];
+        const int x = (int)(i % sy), y = (int)((i / sy) % (size_t)b->dim[1]), z = (int)(i / sz);
+        /* POSE__CELL_OUT + gap of the neighbours: a non-OUT cell's have gap 1. */
+        const int next = (code[i] < POSE__CELL_OUT ? POSE__CELL_OUT : code[i]) + 1;
+        if (next >= 255)
+            continue;
+        for (int dz = -1; dz <= 1; dz++)
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++) {
+                    const int u = x + dx, w = y + dy, t = z + dz;
+                    if (u < 0 || w < 0 || t < 0 || u >= b->dim[0] || w >= b->dim[1] || t >= b->dim[2])
+                        continue;
+                    const size_t j = (size_t)t * sz + (size_t)w * sy + (size_t)u;
+                    if (code[j] > next) {
+                        code[j] = (uint8_t)next;
+                        queue[tail++] = (uint32_t)j;
+                    }
+                }
+    }
+    memset(b->grid, 255, 64 * bricks);
+    for (int z = 0; z < b->dim[2]; z++)
+        for (int y = 0; y < b->dim[1]; y++)
+            for (int x = 0; x < b->dim[0]; x++) {
+                const size_t brick = ((size_t)(z >> 2) * (size_t)b->bricks[1] + (size_t)(y >> 2)) * (size_t)b->bricks[0] +
+                                     (size_t)(x >> 2);
+                b->grid[64 * brick + (size_t)((z & 3) << 4 | (y & 3) << 2 | (x & 3))] =
+                    code[(size_t)z * sz + (size_t)y * sy + (size_t)x];
+            }
+    for (size_t k = 0; k < bricks; k++) {
+        uint8_t least = 255;
+        for (size_t c = 0; c < 64; c++)
+            least = b->grid[64 * k + c] < least ? b->grid[64 * k + c] : least;
+        b->brick_gap[k] = least >= POSE__CELL_OUT ? (uint8_t)(least - (POSE__CELL_OUT - 1)) : 0;
+    }
+    pose__free(a, code);
+    return POSE_OK;
+}
+
+/* The bone's sphere and grid (contact_push.h's cell states): cells a
+ * triangle crosses are SURF, the others that a triangle touches grown by
+ * the margin NEAR_OUT or NEAR_IN, the rest OUT or IN, by a flood fill from
+ * the grid's border (with a rounding allowance on each test). No point of
+ * an OUT cell is inside or within the margin; every point of a SURF or NEAR
+ * cell has a triangle within sqrt(3) (cell + margin); a NEAR_OUT cell is
+ * all outside. (Where a bone's mesh is open the fill leaks in and its
+ * inside reads outside: such points are not pushed.) Then the gap to the
+ * non-OUT cells. */
 static pose_status bone_grid(pose__push_bone *b, const pose__tissue *ts, float margin, const pose_allocator *a)
 {
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -165,9 +278,12 @@ static pose_status bone_grid(pose__push_bone *b, const pose__tissue *ts, float m
         b->hi[d] = b->lo[d] + (float)b->dim[d] * b->cell;
         cells *= (size_t)b->dim[d];
     }
-    b->cells = pose__calloc(a, cells, POSE__ALIGN);
+    b->inv_cell = 1.0f / b->cell;
+    enum { NEAR = 1, SURF = 2, SEEN = 4 }; /* build bits */
+    uint8_t *state = pose__calloc(a, cells, POSE__ALIGN);
     uint32_t *queue = pose__alloc(a, cells * sizeof *queue, POSE__ALIGN);
-    if (!b->cells || !queue) {
+    if (!state || !queue) {
+        pose__free(a, state);
         pose__free(a, queue);
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for a bone grid of %zu cells", cells);
     }
@@ -181,18 +297,27 @@ static pose_status bone_grid(pose__push_bone *b, const pose__tissue *ts, float m
             const float w = fmaxf(fmaxf(x[3 * (size_t)t[0] + (size_t)d], x[3 * (size_t)t[1] + (size_t)d]), x[3 * (size_t)t[2] + (size_t)d]);
             c0[d] = (int)floorf((u - margin - b->lo[d]) / b->cell);
             c1[d] = (int)floorf((w + margin - b->lo[d]) / b->cell);
-            c0[d] = c0[d] < 0 ? 0 : c0[d];
-            c1[d] = c1[d] >= b->dim[d] ? b->dim[d] - 1 : c1[d];
+            c0[d] = c0[d] < 1 ? 0 : c0[d] - 1; /* a cell more: the rounding allowance */
+            c1[d] = c1[d] >= b->dim[d] - 1 ? b->dim[d] - 1 : c1[d] + 1;
         }
+        const uint32_t *t = ts->triangles + 3 * f;
+        const float *x0 = ts->positions + 3 * (size_t)t[0], *x1 = ts->positions + 3 * (size_t)t[1],
+                    *x2 = ts->positions + 3 * (size_t)t[2];
+        const double hs = 0.5 * (double)b->cell + 1e-3 * (double)b->cell, h = hs + (double)margin;
         for (int z = c0[2]; z <= c1[2]; z++)
             for (int y = c0[1]; y <= c1[1]; y++)
-                for (int x = c0[0]; x <= c1[0]; x++)
-                    b->cells[(size_t)z * sz + (size_t)y * sy + (size_t)x * sx] = POSE__CELL_NEAR;
+                for (int x = c0[0]; x <= c1[0]; x++) {
+                    const size_t i = (size_t)z * sz + (size_t)y * sy + (size_t)x * sx;
+                    const double c[3] = {b->lo[0] + (x + 0.5) * (double)b->cell, b->lo[1] + (y + 0.5) * (double)b->cell,
+                                         b->lo[2] + (z + 0.5) * (double)b->cell};
+                    if (!(state[i] & SURF) && tri_box_overlap(c, h, x0, x1, x2))
+                        state[i] |= NEAR | (tri_box_overlap(c, hs, x0, x1, x2) ? SURF : 0);
+                }
     }
-    /* Flood OUT from the border; the cells never reached are IN. Unknown
-     * cells are 0 = POSE__CELL_OUT's value, so the fill marks reached cells
-     * with a temporary state first. */
-    enum { SEEN = 3 };
+    /* Flood from the border through the cells no triangle crosses (each
+     * wholly on one side of the surface, and two such neighbours on the
+     * same side: a triangle on their common face would touch both): the
+     * cells reached are outside, the others inside. */
     size_t head = 0, tail = 0;
     for (int z = 0; z < b->dim[2]; z++)
         for (int y = 0; y < b->dim[1]; y++)
@@ -200,8 +325,8 @@ static pose_status bone_grid(pose__push_bone *b, const pose__tissue *ts, float m
                 const int border = x == 0 || y == 0 || z == 0 || x == b->dim[0] - 1 || y == b->dim[1] - 1 ||
                                    z == b->dim[2] - 1;
                 const size_t i = (size_t)z * sz + (size_t)y * sy + (size_t)x;
-                if (border && b->cells[i] == 0) {
-                    b->cells[i] = SEEN;
+                if (border && !(state[i] & SURF)) {
+                    state[i] |= SEEN;
                     queue[tail++] = (uint32_t)i;
                 }
             }
@@ -214,16 +339,20 @@ static pose_status bone_grid(pose__push_bone *b, const pose__tissue *ts, float m
             if (nx[k] < 0 || ny[k] < 0 || nz[k] < 0 || nx[k] >= b->dim[0] || ny[k] >= b->dim[1] || nz[k] >= b->dim[2])
                 continue;
             const size_t j = (size_t)nz[k] * sz + (size_t)ny[k] * sy + (size_t)nx[k];
-            if (b->cells[j] == 0) {
-                b->cells[j] = SEEN;
+            if (!(state[j] & (SURF | SEEN))) {
+                state[j] |= SEEN;
                 queue[tail++] = (uint32_t)j;
             }
         }
     }
     for (size_t i = 0; i < cells; i++)
-        b->cells[i] = b->cells[i] == SEEN ? POSE__CELL_OUT : b->cells[i] == 0 ? POSE__CELL_IN : b->cells[i];
+        state[i] = state[i] & SURF   ? POSE__CELL_SURF
+                   : state[i] & NEAR ? (state[i] & SEEN ? POSE__CELL_NEAR_OUT : POSE__CELL_NEAR_IN)
+                                     : (state[i] & SEEN ? POSE__CELL_OUT : POSE__CELL_IN);
+    const pose_status r = bone_gap(b, state, queue, a);
+    pose__free(a, state);
     pose__free(a, queue);
-    return POSE_OK;
+    return r;
 }
 
 typedef struct morton_key {
@@ -327,7 +456,8 @@ void pose__push_release(pose__push *p)
         pose__free(a, b->face_n);
         pose__free(a, b->edge_n);
         pose__free(a, b->vert_n);
-        pose__free(a, b->cells);
+        pose__free(a, b->grid);
+        pose__free(a, b->brick_gap);
     }
     pose__free(a, p->bones);
     pose__free(a, p->order);
