@@ -25,12 +25,20 @@
 
 /* The acceptance's bound on a move beyond the depth, and the falls this
  * test holds the response to. The issue asks 0.95 for both; skin in bone
- * falls by 0.977 here (LBS and DQS, the four poses). Bone out of skin does
- * not fall (0.2 %): ~2000 of its ~2100 bone vertices are out at rest (skull,
- * jaw, scapulae: data/anatomy/README.md) and covering bone needs the skin
- * pushed outward over it, which this response does not do: held to "not
- * worse". */
+ * falls by 0.977 here (LBS and DQS, the four poses). Bone out of skin is
+ * counted, as skin in bone is, without the vertices out at rest (2011 of
+ * them: skull, jaw, scapulae; data/anatomy/README.md): 710 over the eight
+ * runs, 677 with the response (4.6 %), since covering bone needs the skin
+ * pushed outward over it, which this response does not do yet: held to
+ * "not worse". A move is bounded by the skin vertex's depth in bone or, for
+ * one lifted over bone, by the protrusion of the bone vertices newly out
+ * of the skin near it (poke_depth). */
 #define MOVE_SLACK 1e-3
+/* Bone vertices newly out of the skin whose protrusion bounds a skin
+ * vertex's outward move: those within this distance of it (the response
+ * lifts the skin over an anchor triangle and a 15 mm falloff beyond). */
+#define POKE_REACH 0.045
+#define MAX_POKES 20000
 #define MIN_FALL_SKIN_IN_BONE 0.95
 #define MIN_FALL_BONE_OUT 0.0
 
@@ -116,6 +124,34 @@ static double bone_depth(const body *b, const pose_state *st, const float *p)
     return depth;
 }
 
+/* Distance from p to the skin `x` (its posed vertices). */
+static double skin_distance(const body *b, const float *x, const float *p)
+{
+    pose_tissue_info ti;
+    assert_int_equal(pose_rig_tissue_info(b->rig, b->skin, &ti), POSE_OK);
+    double d = INFINITY;
+    for (size_t f = 0; f < ti.triangle_count; f++) {
+        const uint32_t *t = ti.triangles + 3 * f;
+        d = fmin(d, tri_distance(p, x + 3 * (size_t)t[0], x + 3 * (size_t)t[1], x + 3 * (size_t)t[2]));
+    }
+    return d;
+}
+
+/* The depth of bone that comes through the skin near skin point p: the
+ * largest protrusion (poke[4 k + 3], the distance of a bone vertex newly
+ * out of the skin to the skin) among those within POKE_REACH of p. */
+static double poke_depth(const float *poke, size_t pokes, const float *p)
+{
+    double depth = 0.0;
+    for (size_t k = 0; k < pokes; k++) {
+        const float *q = poke + 4 * k;
+        const double dx = (double)q[0] - p[0], dy = (double)q[1] - p[1], dz = (double)q[2] - p[2];
+        if (dx * dx + dy * dy + dz * dz < POKE_REACH * POKE_REACH)
+            depth = fmax(depth, q[3]);
+    }
+    return depth;
+}
+
 static void set_response(pose_state *st, int on)
 {
     pose_contact_response r = {.size = sizeof r, .enabled = on};
@@ -185,22 +221,34 @@ static void skin_out_of_bone(void **unused)
     pose_state *st;
     assert_int_equal(pose_state_create_ex(b.rig, &so, &st), POSE_OK);
 
-    /* Rest: which skin is in bone as anatomy (not counted below). */
+    /* Rest: which skin is in bone and which bone is out of the skin as
+     * anatomy or data (not counted below). */
     assert_int_equal(pose_apply(st), POSE_OK);
     assert_int_equal(pose_contact_detect(det, st, NULL), POSE_OK);
     size_t n;
     uint8_t *rest_in = malloc(b.skin_count);
     assert_non_null(rest_in);
     memcpy(rest_in, pose_contact_vertex_flags(det, b.skin, &n), b.skin_count);
-    printf("rest: %zu skin vertices in bone (anatomy: not counted)\n", count_flags(det, b.skin, NULL));
+    uint8_t *rest_out[256];
+    size_t rest_out_count = 0;
+    for (int i = 0; i < b.bone_count; i++) {
+        const uint8_t *f = pose_contact_vertex_flags(det, b.bones[i], &n);
+        rest_out[i] = malloc(n + 1);
+        assert_non_null(rest_out[i]);
+        memcpy(rest_out[i], f, n);
+        rest_out_count += count_flags(det, b.bones[i], NULL);
+    }
+    printf("rest: %zu skin vertices in bone, %zu bone vertices out of the skin (not counted)\n",
+           count_flags(det, b.skin, NULL), rest_out_count);
 
     set_response(st, 1);
     pose_contact_response_stats rs = {.size = sizeof rs};
     assert_int_equal(pose_get_contact_response_stats(st, &rs), POSE_OK);
     printf("response built in %.0f ms, margin %.2f mm\n", 1e3 * rs.build_seconds, 1e3 * rs.margin);
 
-    float *off = malloc(3 * b.skin_count * sizeof(float));
+    float *off = malloc(3 * b.skin_count * sizeof(float)), *poke = malloc(4 * MAX_POKES * sizeof(float));
     assert_non_null(off);
+    assert_non_null(poke);
     const pose_method methods[] = {POSE_LBS, POSE_DQS};
     const char *names[] = {"LBS", "DQS"};
     size_t sum_in_off = 0, sum_in_on = 0, sum_out_off = 0, sum_out_on = 0;
@@ -215,6 +263,22 @@ static void skin_out_of_bone(void **unused)
             pose_contact_counts k_off = {.size = sizeof k_off}, k_on = {.size = sizeof k_on};
             assert_int_equal(pose_contact_detect(det, st, &k_off), POSE_OK);
             const size_t in_before = count_flags(det, b.skin, rest_in);
+            size_t out_before = 0;
+            for (int i = 0; i < b.bone_count; i++)
+                out_before += count_flags(det, b.bones[i], rest_out[i]);
+            /* How far each bone vertex newly out of the skin comes through
+             * it: its distance to the skin without the response. */
+            size_t pokes = 0;
+            for (int i = 0; i < b.bone_count; i++) {
+                const uint8_t *f = pose_contact_vertex_flags(det, b.bones[i], &n);
+                const float *x = pose_tissue_positions(st, b.bones[i], NULL);
+                for (size_t v = 0; v < n && pokes < MAX_POKES; v++)
+                    if (f[v] && !rest_out[i][v]) {
+                        memcpy(poke + 4 * pokes, x + 3 * v, 3 * sizeof(float));
+                        poke[4 * pokes + 3] = (float)skin_distance(&b, off, poke + 4 * pokes);
+                        pokes++;
+                    }
+            }
             /* With the response on, bones follow their joints rigidly: depths
              * are measured in those bones, from the skin without the push. */
             set_response(st, 1);
@@ -231,21 +295,26 @@ static void skin_out_of_bone(void **unused)
                 for (int d = 0; d < 3; d++)
                     e += ((double)on[3 * v + (size_t)d] - off[3 * v + (size_t)d]) *
                          ((double)on[3 * v + (size_t)d] - off[3 * v + (size_t)d]);
-                const double move = sqrt(e), depth = bone_depth(&b, st, off + 3 * v);
+                const double move = sqrt(e),
+                             depth = fmax(bone_depth(&b, st, off + 3 * v), poke_depth(poke, pokes, off + 3 * v));
                 excess = fmax(excess, move - depth);
                 max_move = fmax(max_move, move);
                 moved++;
             }
             const size_t in_after = count_flags(det, b.skin, rest_in);
+            size_t out_after = 0;
+            for (int i = 0; i < b.bone_count; i++)
+                out_after += count_flags(det, b.bones[i], rest_out[i]);
             printf("%s, %-18s: skin in bone %4zu -> %4zu (%4zu -> %4zu with the rest's), bone out of skin "
-                   "%4zu -> %4zu; %4zu moved, up to %5.2f mm, at most %+.3f mm past the depth; pass %.2f ms\n",
+                   "%4zu -> %4zu (%4zu -> %4zu with the rest's); %4zu moved, up to %5.2f mm, at most %+.3f mm past "
+                   "the depth; pass %.2f ms\n",
                    names[m], contact_poses[c].label, in_before, in_after, k_off.skin_in_bone, k_on.skin_in_bone,
-                   k_off.bone_out_of_skin, k_on.bone_out_of_skin, moved, 1e3 * max_move, 1e3 * excess,
-                   1e3 * rs.seconds);
+                   out_before, out_after, k_off.bone_out_of_skin, k_on.bone_out_of_skin, moved, 1e3 * max_move,
+                   1e3 * excess, 1e3 * rs.seconds);
             sum_in_off += in_before;
             sum_in_on += in_after;
-            sum_out_off += k_off.bone_out_of_skin;
-            sum_out_on += k_on.bone_out_of_skin;
+            sum_out_off += out_before;
+            sum_out_on += out_after;
             worst_excess = fmax(worst_excess, excess);
             slowest = fmax(slowest, rs.seconds);
         }
@@ -274,7 +343,10 @@ static void skin_out_of_bone(void **unused)
                         3 * b.skin_count * sizeof(float));
     pose_state_free(one);
     free(off);
+    free(poke);
     free(rest_in);
+    for (int i = 0; i < b.bone_count; i++)
+        free(rest_out[i]);
     pose_contact_free(det);
     pose_state_free(st);
     pose_rig_free(b.rig);
