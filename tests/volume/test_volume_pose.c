@@ -193,18 +193,27 @@ static void test_rigid_turn(void **state)
     pose_state_free(st);
 }
 
+/* The arm bent 35 degrees about y (tets stretch and fold at x = 0), posed. */
+#define BENT_DEG 35.0f
+static pose_state *bent_arm(const fixture *fx)
+{
+    pose_state *st;
+    assert_int_equal(pose_state_create(fx->rig, &st), POSE_OK);
+    float a = BENT_DEG * 3.14159265f / 180.0f;
+    const float q[4] = {0, sinf(a / 2), 0, cosf(a / 2)};
+    assert_int_equal(pose_set_joint(st, 1, q), POSE_OK);
+    assert_int_equal(pose_apply(st), POSE_OK);
+    return st;
+}
+
 /* The arm bent 35 degrees about y (tets stretch and fold at x = 0): the
  * same bytes for 1, 2, 3 and 7 threads; rigid arm voxels sample
  * f(R^-1 x) exactly. */
 static void test_threads_identical(void **state)
 {
     fixture *fx = *state;
-    pose_state *st;
-    assert_int_equal(pose_state_create(fx->rig, &st), POSE_OK);
-    float a = 35.0f * 3.14159265f / 180.0f;
-    const float q[4] = {0, sinf(a / 2), 0, cosf(a / 2)};
-    assert_int_equal(pose_set_joint(st, 1, q), POSE_OK);
-    assert_int_equal(pose_apply(st), POSE_OK);
+    pose_state *st = bent_arm(fx);
+    const float a = BENT_DEG * 3.14159265f / 180.0f;
     size_t n = (size_t)N * N * N;
     float *ref_i = malloc(n * sizeof *ref_i), *vi = malloc(n * sizeof *vi);
     uint16_t *ref_l = malloc(n * sizeof *ref_l), *vl = malloc(n * sizeof *vl);
@@ -268,12 +277,7 @@ static pose_volume_desc crop(const fixture *fx, const int o[3], const uint32_t n
 static void test_variants_identical(void **state)
 {
     fixture *fx = *state;
-    pose_state *st;
-    assert_int_equal(pose_state_create(fx->rig, &st), POSE_OK);
-    float a = 35.0f * 3.14159265f / 180.0f;
-    const float q[4] = {0, sinf(a / 2), 0, cosf(a / 2)};
-    assert_int_equal(pose_set_joint(st, 1, q), POSE_OK);
-    assert_int_equal(pose_apply(st), POSE_OK);
+    pose_state *st = bent_arm(fx);
     const pose_volume_grid *out = &fx->rest.grid;
     size_t n = (size_t)N * N * N;
     float *gi = malloc(n * sizeof *gi), *vi = malloc(n * sizeof *vi);
