@@ -82,7 +82,8 @@ static float push_vertex(const pose__push *p, const pose__push_bone *b, const fl
      * nearest). Nothing there (rounding): outside, it is farther than the
      * margin and stays; inside (a ray says so), it searches on, as one of
      * an IN cell does. */
-    const float near = 1.7320508f * (b->cell + p->margin) * 1.001f;
+    const float near = code == POSE__CELL_SURF ? 1.7320508f * b->cell * 1.003f /* crossed: within its diagonal */
+                                               : 1.7320508f * (b->cell + p->margin) * 1.001f;
     float c[3], out[3];
     float sd = pose__push_distance(b, q,
                                    code == POSE__CELL_NEAR_OUT ? p->margin
