@@ -5,6 +5,7 @@
 #define POSE_TEST_CONTACT_BODY_H
 
 #include <stddef.h>
+#include <stdlib.h>
 
 #include "pose/pose.h"
 
@@ -23,6 +24,16 @@ static const contact_pose contact_poses[] = {
     {"hip flexion 120", {"hip_r", "hip_l"}, 120.0f},
 };
 #define CONTACT_POSE_COUNT (sizeof contact_poses / sizeof contact_poses[0])
+
+/* How many of the poses a test takes: all, or the first $POSE_CONTACT_POSES
+ * (the TSan stage takes one: the threads run the same code at every pose,
+ * and each pose costs minutes there). */
+static inline size_t contact_pose_count(void)
+{
+    const char *e = getenv("POSE_CONTACT_POSES");
+    const long n = e ? strtol(e, NULL, 10) : 0;
+    return n > 0 && (size_t)n < CONTACT_POSE_COUNT ? (size_t)n : CONTACT_POSE_COUNT;
+}
 
 /* Set pose `p` on `st` (from a reset). 0, or -1 naming nothing: a joint is
  * missing or the state refused the angles. */

@@ -275,7 +275,7 @@ static void counts_match_brute_force(void **unused)
      * crosses itself at the mouth (~660 pairs) and the skull and jaw come
      * out of it (data/anatomy/README.md); then the issue's poses. */
     size_t pairs_rest = 0, pairs_posed = 0;
-    for (size_t c = 0; c <= CONTACT_POSE_COUNT; c++) {
+    for (size_t c = 0; c <= contact_pose_count(); c++) {
         const char *label = c ? contact_poses[c - 1].label : "rest (T-pose)";
         if (c)
             set_pose(&b, st, &contact_poses[c - 1]);

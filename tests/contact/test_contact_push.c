@@ -254,7 +254,7 @@ static void skin_out_of_bone(void **unused)
     size_t sum_in_off = 0, sum_in_on = 0, sum_out_off = 0, sum_out_on = 0;
     double worst_excess = -INFINITY, slowest = 0.0;
     for (size_t m = 0; m < 2; m++)
-        for (size_t c = 0; c < CONTACT_POSE_COUNT; c++) {
+        for (size_t c = 0; c < contact_pose_count(); c++) {
             assert_int_equal(contact_pose_set(b.rig, st, &contact_poses[c]), 0);
             assert_int_equal(pose_set_method(st, methods[m]), POSE_OK);
             set_response(st, 0);
