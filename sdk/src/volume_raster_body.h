@@ -33,11 +33,11 @@ typedef struct span {
 typedef float v4f __attribute__((vector_size(16)));
 typedef uint32_t v4u __attribute__((vector_size(16)));
 
-/* Queues voxels i0..i1 of output row `row`, four
- * at a time: a run of up to four, the common case, is one set of vector
- * stores (the queue's slack takes the surplus), not a loop whose length
- * the branch predictor would have to guess. Preimages as the generic
- * sampler would compute them, r + m u with u = i - ia. */
+/* Queues voxels i0..i1 of output row `row`, four at a time: a run of up
+ * to four, the common case, is one set of vector stores (the queue's slack
+ * takes the surplus), not a loop whose length the branch predictor would
+ * have to guess. Preimages r + m u with u = i - ia (small integers, exact
+ * in float), whichever run of the span a voxel falls in. */
 static POSE__INLINE void queue_run(const pose_volume_sampler *s, pose__vol_stage *st,
                                    const span *sp, int i0, int i1, size_t row)
 {
