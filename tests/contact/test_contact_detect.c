@@ -92,6 +92,14 @@ static void mesh_free(mesh *m)
     free(m->tissue);
 }
 
+static void body_free(body *b)
+{
+    pose_rig_free(b->rig);
+    free(b->offset);
+    mesh_free(&b->skin);
+    mesh_free(&b->bone);
+}
+
 /* All tissue vertices of the state in one array, as the library lays them out. */
 static float *gather_positions(const body *b, const pose_state *st)
 {
@@ -250,10 +258,7 @@ static void invalid_arguments(void **unused)
     pose_contact_free(c);
     pose_contact_free(NULL);
     pose_state_free(st);
-    pose_rig_free(b.rig);
-    free(b.offset);
-    mesh_free(&b.skin);
-    mesh_free(&b.bone);
+    body_free(&b);
 }
 
 static void counts_match_brute_force(void **unused)
@@ -333,10 +338,7 @@ static void counts_match_brute_force(void **unused)
     pose_contact_free(one);
     pose_contact_free(two);
     pose_state_free(st);
-    pose_rig_free(b.rig);
-    free(b.offset);
-    mesh_free(&b.skin);
-    mesh_free(&b.bone);
+    body_free(&b);
 }
 
 int main(void)
