@@ -23,7 +23,7 @@
 #define POSE_SOURCE_DIR_DEFAULT "."
 #endif
 
-static void die(const char *what, const pb_error *err)
+static _Noreturn void die(const char *what, const pb_error *err)
 {
     fprintf(stderr, "bench_hid: %s: %s\n", what, err ? err->message : "");
     exit(1);
