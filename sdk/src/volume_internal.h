@@ -16,9 +16,14 @@
 
 /* The output voxel centres a posed tet's bounding box holds, per axis
  * [lo, hi] clipped to the grid; a box without any has k0 > k1 (INT32_MAX,
- * INT32_MIN: outside every slab). Set per call before the slabs run. */
+ * INT32_MIN: outside every slab). identity: the posed tet lies exactly
+ * where it rests (the same index-space bits), so each voxel it covers is
+ * its own preimage and takes the rest voxel's values as they are (most
+ * of a body whose posed joints leave the rest unmoved). Set per call
+ * before the slabs run. */
 typedef struct pose__vol_box {
     int32_t i0, i1, j0, j1, k0, k1;
+    int32_t identity;
 } pose__vol_box;
 
 /* Voxels staged for sampling (one queue per slab part, at most
@@ -59,11 +64,33 @@ struct pose_volume_sampler {
     pose__pool *pool;
     pose__vol_stage *stages; /* one per part */
     int use_avx2;            /* the variant, chosen at creation */
+    /* The rest cover (volume_rest_cover.c), when the output grid is the
+     * rest grid; owner NULL otherwise. */
+    uint16_t *owner;         /* per output voxel: its block at rest, or POSE__VOL_NO_OWNER */
+    uint8_t *block_still;    /* per block (per call): all its tets lie where they rest */
+    unsigned block_shift;    /* a block is 2^block_shift consecutive tets */
+    int owner_building;      /* set while creation rasterizes the rest pose into owner */
     /* the call in flight */
     const float *posed;
     float *dst_intensity;
     uint16_t *dst_labels;
 };
+
+/* The rest cover (volume_rest_cover.c). */
+#define POSE__VOL_NO_OWNER 0xffffu
+/** Whether the sampler keeps a rest cover: the output grid is the rest grid. */
+int pose__vol_rest_cover_wanted(const pose_volume_grid *rest, const pose_volume_grid *out);
+/** Bytes of the rest cover's two arrays (owner, then block_still). */
+size_t pose__vol_rest_cover_bytes(const pose_volume_grid *out);
+/** Takes the arrays (pose__vol_rest_cover_bytes) and clears them; the
+ *  caller then rasterizes the rest pose with owner_building set. */
+void pose__vol_rest_cover_init(pose_volume_sampler *s, uint16_t *owner, uint8_t *still);
+/** block_still of blocks [block0, block1), from the boxes' identity flags. */
+void pose__vol_rest_cover_blocks(pose_volume_sampler *s, size_t block0, size_t block1);
+/** Output planes [k0, k1), after the moved tets: the voxels whose owner is
+ *  still and that no moved tet covered take the rest image's values; all
+ *  whose owner is still are marked covered. */
+void pose__vol_rest_cover_copy(const pose_volume_sampler *s, size_t k0, size_t k1);
 
 /* What a tet's rest positions say, once per sampler: the sign of its
  * volume in the rest image's index space (the posed one must match, or

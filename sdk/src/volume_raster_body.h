@@ -25,7 +25,8 @@
  * depend on the runs). */
 typedef struct span {
     float rx, ry, rz, mx, my, mz;
-    int ia, ib;
+    int ia, ib, j, k;
+    uint16_t block; /* the tet's block (the rest cover's owner while it is built) */
 } span;
 
 /* Four floats (SSE2 everywhere x86-64 and ARMv8 run): a run's preimages
@@ -59,12 +60,51 @@ static POSE__INLINE void queue_run(const pose_volume_sampler *s, pose__vol_stage
     }
 }
 
+/* Voxels i0..i1 of output row (j, k) of a tet that lies where it rests
+ * (pose__vol_box.identity): each is its own preimage, so it takes the rest
+ * voxel's intensity and label as they are (what the gather would give at
+ * an exact voxel centre, without the inverse map's rounding), background
+ * where the output grid reaches past the rest image. */
+static void copy_run(const pose_volume_sampler *s, const span *sp, int i0, int i1, size_t row)
+{
+    if (s->owner_building) { /* the rest pose, rasterized once at creation */
+        for (int i = i0; i <= i1; i++)
+            s->owner[row + (size_t)i] = sp->block;
+        return;
+    }
+    const int j = sp->j, k = sp->k;
+    const pose_volume_desc *r = &s->rest;
+    const int nx = (int)r->grid.nx;
+    const int last = (uint32_t)j < r->grid.ny && (uint32_t)k < r->grid.nz ? (i1 < nx ? i1 : nx - 1)
+                                                                          : i0 - 1;
+    const size_t src = ((size_t)k * r->grid.ny + (size_t)j) * (size_t)nx;
+    float *oi = s->dst_intensity;
+    uint16_t *ol = s->dst_labels;
+    for (int i = i0; i <= i1; i++) {
+        if (oi)
+            oi[row + (size_t)i] = i <= last ? r->intensity[src + (size_t)i] : r->intensity_background;
+        if (ol)
+            ol[row + (size_t)i] = i <= last ? r->labels[src + (size_t)i] : r->label_background;
+    }
+}
+
+/* Samples voxels i0..i1 of a row: queued for the gather, or copied when
+ * the tet lies where it rests (identity, constant per tet). */
+static POSE__INLINE void sample_run(const pose_volume_sampler *s, pose__vol_stage *st,
+                                    const span *sp, int identity, int i0, int i1, size_t row)
+{
+    if (identity)
+        copy_run(s, sp, i0, i1, row);
+    else
+        queue_run(s, st, sp, i0, i1, row);
+}
+
 /* The general case of cover_span: a span over several words of the row,
  * or one some of whose voxels an earlier tet covered (out of line: it
  * keeps the common case's loop small). */
 static __attribute__((noinline)) void cover_words(const pose_volume_sampler *s,
-                                                  pose__vol_stage *st, const span *sp, uint64_t *w,
-                                                  size_t row)
+                                                  pose__vol_stage *st, const span *sp, int identity,
+                                                  uint64_t *w, size_t row)
 {
     const int a = sp->ia >> 6, b = sp->ib >> 6;
     const uint64_t first = ~(uint64_t)0 << (sp->ia & 63), last = ~(uint64_t)0 >> (63 - (sp->ib & 63));
@@ -76,7 +116,7 @@ static __attribute__((noinline)) void cover_words(const pose_volume_sampler *s,
             const int lo = __builtin_ctzll(open);
             const uint64_t after = ~(open >> lo);
             const int len = after ? __builtin_ctzll(after) : 64 - lo;
-            queue_run(s, st, sp, 64 * x + lo, 64 * x + lo + len - 1, row);
+            sample_run(s, st, sp, identity, 64 * x + lo, 64 * x + lo + len - 1, row);
             open = lo + len < 64 ? open & (~(uint64_t)0 << (lo + len)) : 0;
         }
     }
@@ -88,15 +128,15 @@ static __attribute__((noinline)) void cover_words(const pose_volume_sampler *s,
  * sampled once, by the first tet the slab visits (the later in index
  * order), whatever the slab split. */
 static POSE__INLINE void cover_span(const pose_volume_sampler *s, pose__vol_stage *st,
-                                    const span *sp, uint64_t *w, size_t row)
+                                    const span *sp, int identity, uint64_t *w, size_t row)
 {
     const int a = sp->ia >> 6;
     const uint64_t m = (~(uint64_t)0 << (sp->ia & 63)) & (~(uint64_t)0 >> (63 - (sp->ib & 63)));
     if (a == sp->ib >> 6 && !(w[a] & m)) { /* the common case: one word, nothing covered yet */
         w[a] |= m;
-        queue_run(s, st, sp, sp->ia, sp->ib, row);
+        sample_run(s, st, sp, identity, sp->ia, sp->ib, row);
     } else {
-        cover_words(s, st, sp, w, row);
+        cover_words(s, st, sp, identity, w, row);
     }
 }
 
@@ -294,7 +334,9 @@ void POSE__VR(pose__volume_raster_tet)(const pose_volume_sampler *s, size_t t,
         jlo_add[p] = used && cj < 0 ? -1e-3 : -INFINITY;
         jhi_add[p] = used && cj > 0 ? 1e-3 : INFINITY;
     }
-    /* rest = R + M (i, j, k), M = E B. */
+    /* rest = R + M (i, j, k), M = E B (the identity when the tet lies
+     * where it rests: not used then). */
+    const int identity = box->identity;
     double M[3][3], R[3];
     for (int a = 0; a < 3; a++) {
         const double E0 = (double)r[1][a] - r[0][a], E1 = (double)r[2][a] - r[0][a],
@@ -311,7 +353,8 @@ void POSE__VR(pose__volume_raster_tet)(const pose_volume_sampler *s, size_t t,
               Mj_v = v4_load(Mj), Mk_v = v4_load(Mk);
     const size_t nx = s->out.nx, ny = s->out.ny;
     const double i0 = box->i0, i1 = box->i1;
-    span sp = {.mx = (float)M[0][0], .my = (float)M[1][0], .mz = (float)M[2][0]};
+    span sp = {.mx = (float)M[0][0], .my = (float)M[1][0], .mz = (float)M[2][0],
+               .block = (uint16_t)(t >> s->block_shift)};
     for (int k = k0; k <= k1; k++) {
         const double kd = k;
         const v4d jv = v4_madd(ja_v, jk_v, kd);
@@ -322,6 +365,7 @@ void POSE__VR(pose__volume_raster_tet)(const pose_volume_sampler *s, size_t t,
         /* The bounds and preimages of a row from the tet, k and j only,
          * whatever slab this plane falls in. */
         const v4d vk = v4_madd(ba_v, bk_v, kd), rk = v4_madd(R_v, Mk_v, kd);
+        sp.k = k;
         for (int j = j0; j <= j1; j++) {
             const double jd = j;
             const v4d v = v4_madd(vk, bj_v, jd);
@@ -331,9 +375,13 @@ void POSE__VR(pose__volume_raster_tet)(const pose_volume_sampler *s, size_t t,
             sp.ia = iceil(lo), sp.ib = ifloor(hi);
             if (sp.ia > sp.ib)
                 continue;
-            const v4d r0 = v4_madd(v4_madd(rk, Mj_v, jd), Mi_v, (double)sp.ia);
-            sp.rx = (float)v4_lane(r0, 0), sp.ry = (float)v4_lane(r0, 1), sp.rz = (float)v4_lane(r0, 2);
-            cover_span(s, st, &sp, pose__vol_cover_row(s, (size_t)j, (size_t)k),
+            if (!identity) {
+                const v4d r0 = v4_madd(v4_madd(rk, Mj_v, jd), Mi_v, (double)sp.ia);
+                sp.rx = (float)v4_lane(r0, 0), sp.ry = (float)v4_lane(r0, 1),
+                sp.rz = (float)v4_lane(r0, 2);
+            }
+            sp.j = j;
+            cover_span(s, st, &sp, identity, pose__vol_cover_row(s, (size_t)j, (size_t)k),
                        ((size_t)k * ny + (size_t)j) * nx);
         }
     }

@@ -3,11 +3,12 @@
  *
  * Per call: (1) every posed tet vertex into the output grid's index space
  * (parts over vertices); (2) every posed tet's box of output voxel centres
- * (parts over tets); (3) per z-slab of the output (one slab per part):
- * every tet in index order whose box meets the slab is rasterized
- * (volume_raster.c), setting the covered bits of its voxels; (4) the
- * voxels left uncovered get the background, or their neighbours' values
- * in a mesh crack. */
+ * and whether it lies where it rests (parts over tets); (3) per z-slab of
+ * the output (one slab per part): every tet in index order whose box
+ * meets the slab is rasterized (volume_raster_body.h), setting the covered
+ * bits of its voxels, except those the rest cover copies
+ * (volume_rest_cover.c); (4) the voxels left uncovered get the background,
+ * or their neighbours' values in a mesh crack. */
 #include "pose/volume.h"
 
 #include <math.h>
@@ -69,6 +70,8 @@ static size_t voxels_of(const pose_volume_grid *g)
 {
     return (size_t)g->nx * g->ny * g->nz;
 }
+
+static void build_rest_cover(pose_volume_sampler *s);
 
 pose_status pose_volume_sampler_create(const pose_rig *rig, const pose_volume_desc *rest,
                                        const pose_volume_grid *out_grid, int threads,
@@ -148,6 +151,15 @@ pose_status pose_volume_sampler_create(const pose_rig *rig, const pose_volume_de
         pose_volume_sampler_free(s);
         return pose__fail(POSE_ERR_THREAD, "could not start %u worker threads", n - 1);
     }
+    if (pose__vol_rest_cover_wanted(&rest->grid, og)) {
+        const size_t owner_bytes = voxels_of(og) * sizeof(uint16_t);
+        uint16_t *owner = pose__alloc(&a, pose__vol_rest_cover_bytes(og), POSE__ALIGN);
+        if (!owner) {
+            pose_volume_sampler_free(s);
+            return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for a volume sampler");
+        }
+        pose__vol_rest_cover_init(s, owner, (uint8_t *)owner + owner_bytes);
+    }
     for (size_t v = 0; v < ti.vertex_count; v++) {
         const float *p = ti.rest_positions + 3 * v;
         for (int r = 0; r < 3; r++)
@@ -160,6 +172,8 @@ pose_status pose_volume_sampler_create(const pose_rig *rig, const pose_volume_de
             r[c] = s->rest_index + 3 * (size_t)ti.tets[4 * t + c];
         s->tet_flags[t] = (uint8_t)pose__volume_rest_flags(r);
     }
+    if (s->owner)
+        build_rest_cover(s);
     *out = s;
     return POSE_OK;
 }
@@ -179,6 +193,7 @@ void pose_volume_sampler_free(pose_volume_sampler *s)
     pose__free(&a, s->tet_flags);
     pose__free(&a, s->covered);
     pose__free(&a, s->stages);
+    pose__free(&a, s->owner);
     pose__free(&a, s);
 }
 
@@ -196,7 +211,9 @@ size_t pose_volume_sample_bytes(const pose_volume_sampler *s, int intensity, int
     /* outputs written; rest samples read about once each where the body is
      * (bounded by the output size); the covered bits cleared, set and read;
      * posed and index vertices, tets, their boxes written and read. */
-    return 2 * nv * per + 3 * nv / 8 + 3 * s->vertex_count * sizeof(float) * 3 +
+    /* with a rest cover, its owners are read once more */
+    return 2 * nv * per + 3 * nv / 8 + (s->owner ? nv * sizeof *s->owner : 0) +
+           3 * s->vertex_count * sizeof(float) * 3 +
            s->tet_count * (4 * sizeof(uint32_t) + 2 * sizeof(pose__vol_box));
 }
 
@@ -251,19 +268,28 @@ static inline float max4f(float a, float b, float c, float d)
     return c > a ? c : a;
 }
 
-/* Pass 2: the box of output voxel centres of every posed tet. */
+/* Pass 2: the box of output voxel centres of every posed tet, and whether
+ * it lies where it rests (parts of whole blocks: then whether the blocks
+ * of the rest cover are still). */
 static void box_task(void *ctx, unsigned part, unsigned parts)
 {
     pose_volume_sampler *s = ctx;
-    const size_t b = pose__part_begin(s->tet_count, part, parts);
-    const size_t e = pose__part_begin(s->tet_count, part + 1, parts);
+    const size_t blocks = (s->tet_count + ((size_t)1 << s->block_shift) - 1) >> s->block_shift;
+    const size_t block0 = pose__part_begin(blocks, part, parts);
+    const size_t block1 = pose__part_begin(blocks, part + 1, parts);
+    const size_t b = block0 << s->block_shift < s->tet_count ? block0 << s->block_shift : s->tet_count;
+    const size_t e = block1 << s->block_shift < s->tet_count ? block1 << s->block_shift : s->tet_count;
     const int nx = (int)s->out.nx, ny = (int)s->out.ny, nz = (int)s->out.nz;
-    const float *P = s->posed_index;
+    const float *P = s->posed_index, *R = s->rest_index;
     for (size_t t = b; t < e; t++) {
         const uint32_t *tv = s->tets + 4 * t;
         const float *q0 = P + 3 * (size_t)tv[0], *q1 = P + 3 * (size_t)tv[1],
                     *q2 = P + 3 * (size_t)tv[2], *q3 = P + 3 * (size_t)tv[3];
         pose__vol_box *bx = &s->boxes[t];
+        bx->identity = !memcmp(q0, R + 3 * (size_t)tv[0], 3 * sizeof *q0) &&
+                       !memcmp(q1, R + 3 * (size_t)tv[1], 3 * sizeof *q1) &&
+                       !memcmp(q2, R + 3 * (size_t)tv[2], 3 * sizeof *q2) &&
+                       !memcmp(q3, R + 3 * (size_t)tv[3], 3 * sizeof *q3);
         if (!axis_range(min4f(q0[2], q1[2], q2[2], q3[2]), max4f(q0[2], q1[2], q2[2], q3[2]), nz,
                         &bx->k0, &bx->k1) ||
             !axis_range(min4f(q0[1], q1[1], q2[1], q3[1]), max4f(q0[1], q1[1], q2[1], q3[1]), ny,
@@ -272,12 +298,16 @@ static void box_task(void *ctx, unsigned part, unsigned parts)
                         &bx->i0, &bx->i1))
             bx->k0 = INT32_MAX, bx->k1 = INT32_MIN;
     }
+    if (s->owner)
+        pose__vol_rest_cover_blocks(s, block0, block1);
 }
 
 /* Pass 3: one z-slab per part: every tet whose box meets the slab, in
  * reverse index order; a voxel already covered keeps its value (see
- * volume_raster.c), so a voxel inside two posed tets takes the later one
- * and is sampled once. */
+ * volume_raster_body.h), so a voxel inside two posed tets takes the later
+ * one and is sampled once. With a rest cover, the tets of still blocks
+ * are not rasterized: their voxels are copied after the others, where no
+ * moved tet took them (volume_rest_cover.c). */
 static void slab_task(void *ctx, unsigned part, unsigned parts)
 {
     pose_volume_sampler *s = ctx;
@@ -285,9 +315,12 @@ static void slab_task(void *ctx, unsigned part, unsigned parts)
     const int z1 = (int)pose__part_begin(s->out.nz, part + 1, parts) - 1;
     if (z0 > z1)
         return;
+    const int copy_still = s->owner && !s->owner_building;
     const size_t plane = s->cover_words * s->out.ny;
     memset(pose__vol_cover_row(s, 0, (size_t)z0), 0, (size_t)(z1 - z0 + 1) * plane * sizeof(uint64_t));
     const pose__vol_box *bx = s->boxes;
+    const uint8_t *still = s->block_still;
+    const unsigned shift = s->block_shift;
     pose__vol_stage *st = &s->stages[part];
     st->n = 0;
     void (*raster)(const pose_volume_sampler *, size_t, const pose__vol_box *, int, int,
@@ -297,11 +330,13 @@ static void slab_task(void *ctx, unsigned part, unsigned parts)
         raster = pose__volume_raster_tet_avx2;
 #endif
     for (size_t t = s->tet_count; t-- > 0;) {
-        if (bx[t].k1 < z0 || bx[t].k0 > z1)
+        if (bx[t].k1 < z0 || bx[t].k0 > z1 || (copy_still && still[t >> shift]))
             continue;
         raster(s, t, &bx[t], bx[t].k0 > z0 ? bx[t].k0 : z0, bx[t].k1 < z1 ? bx[t].k1 : z1, st);
     }
     pose__volume_gather(s, st);
+    if (copy_still)
+        pose__vol_rest_cover_copy(s, (size_t)z0, (size_t)z1 + 1);
 }
 
 static inline int covered_at(const pose_volume_sampler *s, size_t i, size_t j, size_t k)
@@ -365,6 +400,17 @@ static void fill_task(void *ctx, unsigned part, unsigned parts)
                 }
             }
         }
+}
+
+/* The rest cover's owners: the rest pose through the box and slab passes,
+ * every tet lying where it rests (creation, once). */
+static void build_rest_cover(pose_volume_sampler *s)
+{
+    memcpy(s->posed_index, s->rest_index, 3 * s->vertex_count * sizeof(float));
+    s->owner_building = 1;
+    pose__pool_run(s->pool, box_task, s);
+    pose__pool_run(s->pool, slab_task, s);
+    s->owner_building = 0;
 }
 
 pose_status pose_volume_sample(pose_volume_sampler *s, const pose_state *state,

@@ -317,6 +317,54 @@ static void test_variants_identical(void **state)
     pose_state_free(st);
 }
 
+/* The rest cover (the output grid is the rest grid): the base's tets lie
+ * where they rest, so the sampler copies their voxels instead of
+ * rasterizing them, after the arm's. Against a grid one plane taller (the
+ * same lattice, so no cover: every tet rasterized), the bent arm gives the
+ * same bytes except where the turned arm folds into the base's rest
+ * space: there the arm shows (rigid arm voxels: f(R^-1 x)), not the base. */
+static void test_rest_cover(void **state)
+{
+    fixture *fx = *state;
+    pose_state *st = bent_arm(fx);
+    const float a = BENT_DEG * 3.14159265f / 180.0f;
+    const size_t n = (size_t)N * N * N;
+    float *ci = malloc(n * sizeof *ci), *ri = malloc((n + N * N) * sizeof *ri);
+    uint16_t *cl = malloc(n * sizeof *cl), *rl = malloc((n + N * N) * sizeof *rl);
+    sample(fx, st, 2, ci, cl);
+    pose_volume_grid taller = fx->rest.grid;
+    taller.nz = N + 1;
+    pose_volume_sampler *s;
+    assert_int_equal(pose_volume_sampler_create(fx->rig, &fx->rest, &taller, 2, NULL, &s), POSE_OK);
+    assert_int_equal(pose_volume_sample(s, st, ri, rl), POSE_OK);
+    pose_volume_sampler_free(s);
+    size_t same = 0, folded = 0, base = 0;
+    for (int k = 0; k < N; k++)
+        for (int j = 0; j < N; j++)
+            for (int i = 0; i < N; i++) {
+                const size_t v = ((size_t)k * N + j) * N + i;
+                const float x = C0 + H * i, y = C0 + H * j, z = C0 + H * k;
+                if (x < -0.01f && cl[v] == fx->labels[v])
+                    base += ci[v] == fx->intensity[v]; /* copied as it is */
+                if (ci[v] == ri[v] && cl[v] == rl[v]) {
+                    same++;
+                    continue;
+                }
+                /* a voxel of the base's rest space the arm turned into */
+                folded++;
+                assert_true(x < 0.0f);
+                const float px = cosf(a) * x - sinf(a) * z, pz = sinf(a) * x + cosf(a) * z;
+                if (px > 0.02f && inside_lattice(i, j, k))
+                    assert_true(fabs(ci[v] - f_lin(px, y, pz)) < 0.05);
+            }
+    printf("rest cover: %zu voxels the same bytes, %zu where the arm folds into the base; "
+           "%zu base voxels copied\n", same, folded, base);
+    assert_true(folded > 0 && folded < n / 50);
+    assert_true(base > 10000);
+    free(ci), free(ri), free(cl), free(rl);
+    pose_state_free(st);
+}
+
 /* An output grid of its own: 2.5 mm voxels over the middle 10 cm. */
 static void test_output_grid(void **state)
 {
@@ -454,6 +502,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_rest_is_identity),  cmocka_unit_test(test_rigid_turn),
         cmocka_unit_test(test_threads_identical), cmocka_unit_test(test_variants_identical),
+        cmocka_unit_test(test_rest_cover),
         cmocka_unit_test(test_output_grid),       cmocka_unit_test(test_errors),
         cmocka_unit_test(test_rig_volumes),
     };

@@ -10,12 +10,19 @@
  * map: intensities are sampled trilinearly, labels take the nearest voxel.
  * Output voxels inside no posed tet get the background values.
  *
+ * When the output grid is the rest grid (the default), the sampler keeps
+ * which tets hold each voxel at rest (2 bytes a voxel): the voxels of tets
+ * a pose leaves where they rest (most of a patient when a few joints
+ * move) are copied from the rest image, not resampled.
+ *
  * Threads: a sampler owns a worker pool; pose_volume_sample splits the
- * output grid into slabs of z, one per thread, and a voxel inside two posed
+ * output grid into slabs of z, one per thread. A voxel inside two posed
  * tets (where the deformation folds, or a centre on a shared face) takes
- * the later tet in index order whatever the slab, so the output is
- * identical for any thread count. pose_volume_sample allocates nothing: everything is allocated by
- * pose_volume_sampler_create. libc, libm and pthreads only, as libpose.
+ * a tet that moved over one that lies where it rests, else the later tet
+ * in index order, whatever the slab, so the output is identical for any
+ * thread count. pose_volume_sample allocates nothing: everything is
+ * allocated by pose_volume_sampler_create. libc, libm and pthreads only,
+ * as libpose.
  */
 #ifndef POSE_VOLUME_H
 #define POSE_VOLUME_H
