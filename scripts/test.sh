@@ -24,7 +24,7 @@ run_suite() { # <build dir> <label filter or ""> <cmake args...>
 echo "== build (gcc, RelWithDebInfo, with benchmarks) and test"
 run_suite "$root/build" "" -DPOSE_BUILD_BENCH=ON   # benchmarks are built (not run) so they keep compiling
 echo "== build with clang and test under ASan+UBSan"
-CC=clang CXX=clang++ run_suite "$root/build-asan" "" -DPOSE_SANITIZE=ON
+CC=clang CXX=clang++ run_suite "$root/build-asan" "" -DPOSE_SANITIZE=ON -DPOSE_BUILD_BENCH=ON   # clang compiles the benchmarks too
 echo "== threaded tests under TSan (the examples' threads too)"
 run_suite "$root/build-tsan" "threads" -DPOSE_TSAN=ON
 echo "== Windows: libpose cross-built with mingw-w64, its tests under wine64"
