@@ -67,6 +67,7 @@ struct pose_volume_sampler {
     /* The rest cover (volume_rest_cover.c), when the output grid is the
      * rest grid; owner NULL otherwise. */
     uint16_t *owner;         /* per output voxel: its block at rest, or POSE__VOL_NO_OWNER */
+    uint32_t *owned_words;   /* per output row: the words [first, end) holding owned voxels */
     uint8_t *block_still;    /* per block (per call): all its tets lie where they rest */
     unsigned block_shift;    /* a block is 2^block_shift consecutive tets */
     int owner_building;      /* set while creation rasterizes the rest pose into owner */
@@ -80,11 +81,15 @@ struct pose_volume_sampler {
 #define POSE__VOL_NO_OWNER 0xffffu
 /** Whether the sampler keeps a rest cover: the output grid is the rest grid. */
 int pose__vol_rest_cover_wanted(const pose_volume_grid *rest, const pose_volume_grid *out);
-/** Bytes of the rest cover's two arrays (owner, then block_still). */
+/** Bytes of the rest cover's arrays (one allocation). */
 size_t pose__vol_rest_cover_bytes(const pose_volume_grid *out);
-/** Takes the arrays (pose__vol_rest_cover_bytes) and clears them; the
- *  caller then rasterizes the rest pose with owner_building set. */
-void pose__vol_rest_cover_init(pose_volume_sampler *s, uint16_t *owner, uint8_t *still);
+/** Takes the arrays (pose__vol_rest_cover_bytes bytes, the sampler frees
+ *  them as owned_words) and clears the owners; the caller then rasterizes
+ *  the rest pose with owner_building set, then calls
+ *  pose__vol_rest_cover_rows. */
+void pose__vol_rest_cover_init(pose_volume_sampler *s, void *arrays);
+/** Each row's owned words, from the owners. */
+void pose__vol_rest_cover_rows(pose_volume_sampler *s);
 /** block_still of blocks [block0, block1), from the boxes' identity flags. */
 void pose__vol_rest_cover_blocks(pose_volume_sampler *s, size_t block0, size_t block1);
 /** Output planes [k0, k1), after the moved tets: the voxels whose owner is

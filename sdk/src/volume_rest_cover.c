@@ -36,19 +36,40 @@ int pose__vol_rest_cover_wanted(const pose_volume_grid *rest, const pose_volume_
     return memcmp(rest, out, sizeof *rest) == 0;
 }
 
+/* The arrays, in one allocation: per output row its owned words [first,
+ * end) (8 bytes), per voxel its owner (2 bytes), per block its still flag
+ * (one byte, for every 16-bit id). */
 size_t pose__vol_rest_cover_bytes(const pose_volume_grid *out)
 {
-    return (size_t)out->nx * out->ny * out->nz * sizeof(uint16_t) +
+    const size_t rows = (size_t)out->ny * out->nz;
+    return rows * 2 * sizeof(uint32_t) + rows * out->nx * sizeof(uint16_t) +
            (POSE__VOL_NO_OWNER + 1) * sizeof(uint8_t);
 }
 
-void pose__vol_rest_cover_init(pose_volume_sampler *s, uint16_t *owner, uint8_t *still)
+void pose__vol_rest_cover_init(pose_volume_sampler *s, void *arrays)
 {
+    const size_t rows = (size_t)s->out.ny * s->out.nz, voxels = rows * s->out.nx;
     s->block_shift = block_shift_for(s->tet_count);
-    s->owner = owner;
-    s->block_still = still;
-    memset(still, 0, POSE__VOL_NO_OWNER + 1); /* POSE__VOL_NO_OWNER stays 0 */
-    memset(owner, 0xff, (size_t)s->out.nx * s->out.ny * s->out.nz * sizeof *owner);
+    s->owned_words = arrays;
+    s->owner = (uint16_t *)(s->owned_words + 2 * rows);
+    s->block_still = (uint8_t *)(s->owner + voxels);
+    memset(s->block_still, 0, POSE__VOL_NO_OWNER + 1); /* POSE__VOL_NO_OWNER stays 0 */
+    memset(s->owner, 0xff, voxels * sizeof *s->owner);
+}
+
+void pose__vol_rest_cover_rows(pose_volume_sampler *s)
+{
+    const size_t nx = s->out.nx, rows = (size_t)s->out.ny * s->out.nz;
+    for (size_t r = 0; r < rows; r++) {
+        const uint16_t *own = s->owner + r * nx;
+        size_t lo = 0, hi = nx;
+        while (lo < nx && own[lo] == POSE__VOL_NO_OWNER)
+            lo++;
+        while (hi > lo && own[hi - 1] == POSE__VOL_NO_OWNER)
+            hi--;
+        s->owned_words[2 * r] = (uint32_t)(lo / 64);
+        s->owned_words[2 * r + 1] = lo < hi ? (uint32_t)((hi + 63) / 64) : (uint32_t)(lo / 64);
+    }
 }
 
 void pose__vol_rest_cover_blocks(pose_volume_sampler *s, size_t block0, size_t block1)
@@ -64,40 +85,47 @@ void pose__vol_rest_cover_blocks(pose_volume_sampler *s, size_t block0, size_t b
     }
 }
 
+/* The still bits of owners own[0 .. n), n <= 64. */
+static inline uint64_t still_bits(const uint8_t *still, const uint16_t *own, size_t n)
+{
+    uint64_t m = 0;
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) /* eight lookups per shift: no loop-carried chain per voxel */
+        m |= (uint64_t)(still[own[i]] | still[own[i + 1]] << 1 | still[own[i + 2]] << 2 |
+                        still[own[i + 3]] << 3 | still[own[i + 4]] << 4 | still[own[i + 5]] << 5 |
+                        still[own[i + 6]] << 6 | still[own[i + 7]] << 7)
+             << i;
+    for (; i < n; i++)
+        m |= (uint64_t)still[own[i]] << i;
+    return m;
+}
+
 void pose__vol_rest_cover_copy(const pose_volume_sampler *s, size_t k0, size_t k1)
 {
-    const size_t nx = s->out.nx, ny = s->out.ny, plane = nx * ny;
-    const uint8_t *still = s->block_still;
+    const size_t nx = s->out.nx, ny = s->out.ny;
     const float *ri = s->rest.intensity;
     const uint16_t *rl = s->rest.labels;
     float *oi = s->dst_intensity;
     uint16_t *ol = s->dst_labels;
-    for (size_t k = k0; k < k1; k++)
-        for (size_t j = 0; j < ny; j++) {
-            const size_t row = k * plane + j * nx;
-            const uint16_t *own = s->owner + row;
-            uint64_t *w = pose__vol_cover_row(s, j, k);
-            for (size_t x = 0; x < s->cover_words; x++) {
-                const size_t i0 = 64 * x, n = nx - i0 < 64 ? nx - i0 : 64;
-                uint64_t m = 0;
-                for (size_t i = 0; i < n; i++)
-                    m |= (uint64_t)still[own[i0 + i]] << i;
-                const uint64_t take = m & ~w[x]; /* not taken by a moved tet */
-                w[x] |= m;
-                if (take == ~(uint64_t)0) { /* inside the body, 64 at once */
-                    if (oi)
-                        memcpy(oi + row + i0, ri + row + i0, 64 * sizeof *oi);
-                    if (ol)
-                        memcpy(ol + row + i0, rl + row + i0, 64 * sizeof *ol);
-                    continue;
-                }
-                for (uint64_t b = take; b; b &= b - 1) {
-                    const size_t v = row + i0 + (size_t)__builtin_ctzll(b);
-                    if (oi)
-                        oi[v] = ri[v];
-                    if (ol)
-                        ol[v] = rl[v];
-                }
+    for (size_t r = k0 * ny; r < k1 * ny; r++) {
+        const size_t row = r * nx;
+        uint64_t *w = pose__vol_cover_row(s, r % ny, r / ny);
+        for (size_t x = s->owned_words[2 * r]; x < s->owned_words[2 * r + 1]; x++) {
+            const size_t i0 = 64 * x, n = nx - i0 < 64 ? nx - i0 : 64;
+            const uint64_t m = still_bits(s->block_still, s->owner + row + i0, n);
+            uint64_t take = m & ~w[x]; /* not taken by a moved tet */
+            w[x] |= m;
+            while (take) { /* runs of voxels to copy */
+                const int lo = __builtin_ctzll(take);
+                const uint64_t after = ~(take >> lo);
+                const int len = after ? __builtin_ctzll(after) : 64 - lo;
+                const size_t v = row + i0 + (size_t)lo;
+                if (oi)
+                    memcpy(oi + v, ri + v, (size_t)len * sizeof *oi);
+                if (ol)
+                    memcpy(ol + v, rl + v, (size_t)len * sizeof *ol);
+                take = lo + len < 64 ? take & (~(uint64_t)0 << (lo + len)) : 0;
             }
         }
+    }
 }

@@ -152,13 +152,12 @@ pose_status pose_volume_sampler_create(const pose_rig *rig, const pose_volume_de
         return pose__fail(POSE_ERR_THREAD, "could not start %u worker threads", n - 1);
     }
     if (pose__vol_rest_cover_wanted(&rest->grid, og)) {
-        const size_t owner_bytes = voxels_of(og) * sizeof(uint16_t);
-        uint16_t *owner = pose__alloc(&a, pose__vol_rest_cover_bytes(og), POSE__ALIGN);
-        if (!owner) {
+        void *arrays = pose__alloc(&a, pose__vol_rest_cover_bytes(og), POSE__ALIGN);
+        if (!arrays) {
             pose_volume_sampler_free(s);
             return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for a volume sampler");
         }
-        pose__vol_rest_cover_init(s, owner, (uint8_t *)owner + owner_bytes);
+        pose__vol_rest_cover_init(s, arrays);
     }
     for (size_t v = 0; v < ti.vertex_count; v++) {
         const float *p = ti.rest_positions + 3 * v;
@@ -193,7 +192,7 @@ void pose_volume_sampler_free(pose_volume_sampler *s)
     pose__free(&a, s->tet_flags);
     pose__free(&a, s->covered);
     pose__free(&a, s->stages);
-    pose__free(&a, s->owner);
+    pose__free(&a, s->owned_words);
     pose__free(&a, s);
 }
 
@@ -411,6 +410,7 @@ static void build_rest_cover(pose_volume_sampler *s)
     pose__pool_run(s->pool, box_task, s);
     pose__pool_run(s->pool, slab_task, s);
     s->owner_building = 0;
+    pose__vol_rest_cover_rows(s);
 }
 
 pose_status pose_volume_sample(pose_volume_sampler *s, const pose_state *state,
