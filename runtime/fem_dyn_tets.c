@@ -35,16 +35,16 @@ void pose__fem_dyn_tets_build(const pose__fem_mesh *m, pose__fem_dyn_tets *tets,
 }
 
 void pose__fem_dyn_rotate(const pose__fem_dyn_tets *tets, pose__fem_dyn_rot *rot, const float *x,
-                          const float *v, int steps, float *f, float *kv, float *blk, size_t b,
-                          size_t e)
+                          const float *v, int steps, float twist, float *f, float *kv, float *blk,
+                          uint32_t *flag, size_t b, size_t e)
 {
 #ifdef POSE__HAVE_AVX2_KERNELS
     if (pose__kernels_use_avx2()) {
-        pose__fem_dyn_rotate_avx2(tets, rot, x, v, steps, f, kv, blk, b, e);
+        pose__fem_dyn_rotate_avx2(tets, rot, x, v, steps, twist, f, kv, blk, flag, b, e);
         return;
     }
 #endif
-    pose__fem_dyn_rotate_generic(tets, rot, x, v, steps, f, kv, blk, b, e);
+    pose__fem_dyn_rotate_generic(tets, rot, x, v, steps, twist, f, kv, blk, flag, b, e);
 }
 
 void pose__fem_dyn_product(const pose__fem_dyn_tets *tets, const pose__fem_dyn_rot *rot,

@@ -14,11 +14,11 @@
  *
  * The stress is plain co-rotated linear elasticity, volume term included
  * (tr(R^T F) - 3, not the quasi-static solver's det F): force and warped
- * stiffness R K0 R^T then agree up to R's own derivative, which backward
- * Euler needs (the det F term's curvature, left out of its Gauss-Newton
- * stiffness, is of the size of the volume stiffness itself once a tet
- * inverts, and backward Euler integrated it explicitly: the body's swing
- * blew up).
+ * stiffness R K0 R^T then agree up to R's own derivative, which
+ * fem_dyn_twist.h adds where it is large (the det F term's curvature, left
+ * out of its Gauss-Newton stiffness, is of the size of the volume stiffness
+ * itself once a tet inverts, and backward Euler integrated it explicitly:
+ * the body's swing blew up).
  *
  * Compiled once per instruction set (fem_dyn_tets_body.h), chosen at run
  * time as rt_kernels.h's; every variant does the same IEEE operations, so
@@ -72,11 +72,13 @@ void pose__fem_dyn_rot_reset(const pose__fem_mesh *m, pose__fem_dyn_rot *rot);
  * Blocks [b, e): rotations at x (at most `steps` extraction steps from the
  * last ones), the elastic corner forces of co-rotated linear elasticity at x
  * into f, the products K v with the new rotations into kv (12 rows each),
- * and the corners' diagonal stiffness blocks into blk (24 rows).
+ * the corners' diagonal stiffness blocks into blk (24 rows), and into flag
+ * (one row of 8 per block) all bits set for each tet whose twist stiffness,
+ * which K leaves out, may exceed (1 + twist) 2 vmu (fem_dyn_twist.h), else 0.
  */
 void pose__fem_dyn_rotate(const pose__fem_dyn_tets *tets, pose__fem_dyn_rot *rot, const float *x,
-                          const float *v, int steps, float *f, float *kv, float *blk, size_t b,
-                          size_t e);
+                          const float *v, int steps, float twist, float *f, float *kv, float *blk,
+                          uint32_t *flag, size_t b, size_t e);
 /**
  * Blocks [b, e): corner products K u with the last rotations into out (12
  * rows), and each tet's u^T K u into energy (one row of 8 per block).
@@ -87,8 +89,9 @@ void pose__fem_dyn_product(const pose__fem_dyn_tets *tets, const pose__fem_dyn_r
 /* The variants behind the two above. */
 #define POSE__FEM_DYN_VARIANT_DECL(sfx)                                                          \
     void pose__fem_dyn_rotate_##sfx(const pose__fem_dyn_tets *tets, pose__fem_dyn_rot *rot,      \
-                                    const float *x, const float *v, int steps, float *f,         \
-                                    float *kv, float *blk, size_t b, size_t e);                  \
+                                    const float *x, const float *v, int steps, float twist,      \
+                                    float *f, float *kv, float *blk, uint32_t *flag, size_t b,   \
+                                    size_t e);                                                   \
     void pose__fem_dyn_product_##sfx(const pose__fem_dyn_tets *tets,                             \
                                      const pose__fem_dyn_rot *rot, const float *u, float *out,   \
                                      float *energy, size_t b, size_t e);

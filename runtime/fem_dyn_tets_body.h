@@ -100,6 +100,37 @@ static POSE__INLINE void blocks8(const pose__fem_dyn_tets *t, const pose__v8f R[
     }
 }
 
+/* Which tets need the rotation's derivative (fem_dyn_twist.h): with S =
+ * R^T F (= H + I here) and s_k = tr S - sigma_k the stiffness of the twist
+ * about S's axis k is 2 vmu + c / s_k, c = 2 vlambda (tr S - 3) - 4 vmu, of
+ * which R K0 R^T holds none. Flagged (all bits set) when c > 0 and c / h >
+ * twist 2 vmu with h = det M / e2(M) (M = tr S I - sym S, whose
+ * eigenvalues are the s_k; s_min / 3 <= h <= s_min when they are
+ * positive), so every tet whose twist stiffness exceeds (1 + twist) 2 vmu
+ * is flagged; and when det M <= 0 (R short of the maximum of tr(R^T F),
+ * which fem_dyn_twist.c restarts the extraction at). Padding lanes (zero
+ * moduli) never are. */
+static POSE__INLINE void twist8(const pose__fem_dyn_tets *t, const pose__v8f H[9], float twist,
+                                uint32_t *flag)
+{
+    const pose__v8f half = V8_SPLAT(0.5f), one = V8_SPLAT(1.0f);
+    const pose__v8f s0 = H[0] + one, s1 = H[4] + one, s2 = H[8] + one, tr = s0 + s1 + s2;
+    const pose__v8f a = half * (H[1] + H[3]), b = half * (H[2] + H[6]), c = half * (H[5] + H[7]);
+    const pose__v8f m0 = s1 + s2, m1 = s0 + s2, m2 = s0 + s1;
+    /* M's off-diagonals are -a, -b, -c: their signs cancel in e2 and det's
+     * last term is -2abc */
+    const pose__v8f e2 = m0 * m1 + m0 * m2 + m1 * m2 - (a * a + b * b + c * c);
+    const pose__v8f det =
+        m0 * (m1 * m2 - c * c) - a * a * m2 - b * b * m1 - V8_SPLAT(2.0f) * a * b * c;
+    const pose__v8f vmu = LOAD8(t->vmu);
+    const pose__v8f cc =
+        V8_SPLAT(2.0f) * LOAD8(t->vlambda) * (tr - V8_SPLAT(3.0f)) - V8_SPLAT(4.0f) * vmu;
+    const pose__v8i f = ((pose__v8i)(cc > V8_SPLAT(0.0f)) &
+                         (pose__v8i)(cc * e2 > V8_SPLAT(2.0f * twist) * vmu * det)) |
+                        ((pose__v8i)(det <= V8_SPLAT(0.0f)) & (pose__v8i)(vmu > V8_SPLAT(0.0f)));
+    *(pose__v8i *)(void *)flag = f;
+}
+
 /* The block's corner values of a per-vertex field (3 floats per vertex). */
 static POSE__INLINE void gather8(const pose__fem_dyn_tets *t, const float *u, pose__v8f out[4][3])
 {
@@ -118,8 +149,9 @@ static POSE__INLINE void gather8(const pose__fem_dyn_tets *t, const float *u, po
 }
 
 void POSE__KV(pose__fem_dyn_rotate)(const pose__fem_dyn_tets *tets, pose__fem_dyn_rot *rot,
-                                    const float *x, const float *v, int steps, float *f,
-                                    float *kv, float *blk, size_t b, size_t e)
+                                    const float *x, const float *v, int steps, float twist,
+                                    float *f, float *kv, float *blk, uint32_t *flag, size_t b,
+                                    size_t e)
 {
     const size_t rows = 12 * POSE__FEM_LANES;
     for (size_t k = b; k < e; k++) {
@@ -141,6 +173,7 @@ void POSE__KV(pose__fem_dyn_rotate)(const pose__fem_dyn_tets *tets, pose__fem_dy
         H[4] -= V8_SPLAT(1.0f);
         H[8] -= V8_SPLAT(1.0f);
         corners8(t, R, H, 1, f + k * rows, NULL);
+        twist8(t, H, twist, flag + k * POSE__FEM_LANES);
         /* K v with the new rotations: the warm start's product */
         gather8(t, v, u);
         grad8(t, u, F);

@@ -107,7 +107,8 @@ void pose__fem_dyn_islands(const pose__fem_mesh *m, uint32_t *p, size_t *island_
 
 typedef struct layout {
     size_t island, tet_island, seg_offset, seg_first, seg_island, x, v, bone_prev, stiff, tets,
-        rot, f, kv, blk, corner, energy, group_sum, group_island, seg_sum, isl, alpha, beta, size;
+        rot, f, kv, blk, flag, twist_count, twist, corner, energy, group_sum, group_island, seg_sum,
+        isl, alpha, beta, size;
 } layout;
 
 static layout layout_of(const pose__fem_mesh *m, size_t islands, size_t segs)
@@ -131,6 +132,10 @@ static layout layout_of(const pose__fem_mesh *m, size_t islands, size_t segs)
     TAKE(f, nb * rows);
     TAKE(kv, nb * rows);
     TAKE(blk, 2 * nb * rows);
+    TAKE(flag, nb * POSE__FEM_LANES * sizeof(uint32_t));
+    TAKE(twist_count, pose__fem_dyn_groups(m) * sizeof(uint32_t));
+    TAKE(twist,
+         pose__fem_dyn_groups(m) * POSE__FEM_GROUP * POSE__FEM_LANES * sizeof(pose__fem_twist));
     TAKE(corner, m->corner_offset[nv] * sizeof(uint32_t));
     TAKE(energy, nb * POSE__FEM_LANES * sizeof(float));
     TAKE(group_sum, pose__fem_dyn_groups(m) * sizeof(double));
@@ -172,6 +177,9 @@ void pose__fem_dyn_init(const pose__fem_mesh *m, const uint32_t *island, size_t 
         .f = (float *)(b + l.f),
         .kv = (float *)(b + l.kv),
         .blk = (float *)(b + l.blk),
+        .flag = (uint32_t *)(b + l.flag),
+        .twist_count = (uint32_t *)(b + l.twist_count),
+        .twist = (pose__fem_twist *)(b + l.twist),
         .corner = (uint32_t *)(b + l.corner),
         .energy = (float *)(b + l.energy),
         .group_sum = (double *)(b + l.group_sum),
@@ -440,6 +448,8 @@ static void product_group(const pose__fem_mesh *m, pose__fem_work *w, pose__fem_
     const size_t nb = pose__fem_dyn_blocks(m), b = g * POSE__FEM_GROUP;
     const size_t e = b + POSE__FEM_GROUP < nb ? b + POSE__FEM_GROUP : nb;
     pose__fem_dyn_product(d->tets, d->rot, w->z, d->f, d->energy, b, e);
+    pose__fem_dyn_twist_product(d->tets, d->rot, d->twist + g * POSE__FEM_GROUP * POSE__FEM_LANES,
+                                d->twist_count[g], w->z, d->f, d->energy);
     if (d->group_island[g] == POSE__FEM_KINEMATIC)
         return;
     double sum = 0.0;
@@ -490,9 +500,13 @@ static void pass_item(void *ctx, size_t item)
             volume_item(c);
             return;
         }
-        const size_t nb = pose__fem_dyn_blocks(m), b = (item - 1) * POSE__FEM_GROUP;
+        const size_t g = item - 1, nb = pose__fem_dyn_blocks(m), b = g * POSE__FEM_GROUP;
         const size_t e = b + POSE__FEM_GROUP < nb ? b + POSE__FEM_GROUP : nb;
-        pose__fem_dyn_rotate(d->tets, d->rot, d->x, d->v, FEM_POLAR_STEPS, d->f, d->kv, d->blk, b, e);
+        pose__fem_dyn_rotate(d->tets, d->rot, d->x, d->v, FEM_POLAR_STEPS, POSE__FEM_TWIST, d->f,
+                             d->kv, d->blk, d->flag, b, e);
+        d->twist_count[g] = (uint32_t)pose__fem_dyn_twist_build(
+            d->tets, d->rot, d->flag, d->x, d->v, d->kv, d->blk, b, e,
+            d->twist + g * POSE__FEM_GROUP * POSE__FEM_LANES);
         return;
     }
     if (c->pass == PASS_PRODUCT) {
@@ -661,11 +675,12 @@ double pose__fem_dyn_bytes(const pose__fem_mesh *m, double cg_iterations)
 {
     const double nt = (double)m->tet_count, nv = (double)m->vertex_count;
     /* per tet: rotate (block constants 60, quaternion r+w 32, matrix 36,
-     * x and v at 4 corners 96, forces, K v and blocks 192), and the
-     * residual pass's gathers of its 4 corners (index 4 + forces 12 + K v
-     * 12 + block 24 each); per vertex: the forces and residual passes
-     * (~112 each) and the integration (80) */
-    const double assembly = nt * (60.0 + 32.0 + 36.0 + 96.0 + 192.0 + 4.0 * 52.0) +
+     * x and v at 4 corners 96, forces, K v and blocks 192, the twist flag
+     * written and read 8), and the residual pass's gathers of its 4
+     * corners (index 4 + forces 12 + K v 12 + block 24 each); per vertex:
+     * the forces and residual passes (~112 each) and the integration (80).
+     * The few flagged tets' twists (fem_dyn_twist.h) are left out. */
+    const double assembly = nt * (60.0 + 32.0 + 36.0 + 96.0 + 192.0 + 8.0 + 4.0 * 52.0) +
                             nv * (112.0 + 112.0 + 80.0);
     /* per iteration: product (block constants 60, rotation 36, u at 4
      * corners 48, products 48, energy 4), the gather of its corners

@@ -8,7 +8,8 @@
  * for the new velocities v' (x' = x + dt v'), with f and K the forces and
  * warped stiffness R K0 R^T of plain co-rotated linear elasticity
  * (rotations taken at x; fem_dyn_tets.h says why not the det F volume
- * term of the quasi-static solver) plus the skin's
+ * term of the quasi-static solver; fem_dyn_twist.h adds R's derivative to K
+ * for the tets where it is large) plus the skin's
  * volume term, Rayleigh damping
  * D = alpha M + beta (K + K_s), and K_s the zero-length springs that couple
  * every bone node (a vertex of a bone tet that is also a soft tet's) to its
@@ -32,6 +33,7 @@
 #include <stdint.h>
 
 #include "fem_dyn_tets.h"
+#include "fem_dyn_twist.h"
 #include "fem_mesh.h"
 #include "fem_solve.h"
 #include "rt_pool.h"
@@ -97,6 +99,9 @@ typedef struct pose__fem_dyn {
     float *f;               /**< per block, 12 rows: elastic forces, then the CG's products */
     float *kv;              /**< per block, 12 rows: K v of the rotate pass */
     float *blk;             /**< per block, 24 rows: the corners' stiffness blocks */
+    uint32_t *flag;         /**< per tet (whole blocks): its twists are added (fem_dyn_twist.h) */
+    uint32_t *twist_count;  /**< per group: how many of its tets are in twist */
+    pose__fem_twist *twist; /**< per group, POSE__FEM_GROUP * POSE__FEM_LANES: its flagged tets */
     uint32_t *corner;       /**< per mesh corner entry (mesh->corners' order): its offset
                                  in a 12-row output (pose__fem_dyn_corner) */
     float *energy;          /**< per tet (whole blocks): u^T K u of the last product */
