@@ -3,8 +3,8 @@
  * bridge's 120 Hz: bone tissues rigid through ramps to the issue's five
  * postures; elbows bent 0 -> 90 degrees at 360 deg/s, then held: finite,
  * the tissue within a bounded distance of the skinned pose, the kinetic
- * energy below 1e-6 of its peak within 1 s; knees and elbows so: finite and
- * bounded (the knees do not settle, see test_knees_bounded); 1 and 2
+ * energy below 1e-6 of its peak within 1 s; knees and elbows together the
+ * same, and what is left after it stays below 5e-5 of the peak; 1 and 2
  * threads the same bits. The rig comes from the fem_body_rig fixture
  * (POSE_FEM_RIG). */
 #include <math.h>
@@ -137,6 +137,7 @@ static double largest_distance(const float *x, const float *y, size_t n)
 typedef struct bend {
     double peak;      /* kinetic energy, J */
     double settled_s; /* after the ramp's end, to below 1e-6 of the peak; -1: not within the hold */
+    double after;     /* the largest kinetic energy after settled_s, J */
     double ke_end;    /* the last step's kinetic energy */
     double lag;       /* largest distance of a tet vertex from the skinned pose, m */
     double bones;     /* largest distance of a bone tissue vertex from its rigid motion, m */
@@ -179,6 +180,8 @@ static bend bend_and_hold(const char *const *names, int n, int hold_steps, int u
         double b = fx_bone_deviation(g_rig, st);
         assert_true(b >= 0.0);
         r.bones = fmax(r.bones, b);
+        if (r.settled_s >= 0.0)
+            r.after = fmax(r.after, r.ke_end);
         if (r.ke_end > r.peak) {
             r.peak = r.ke_end;
         } else if (k > RAMP_STEPS && r.settled_s < 0.0 && r.ke_end < 1e-6 * r.peak) {
@@ -193,10 +196,10 @@ static bend bend_and_hold(const char *const *names, int n, int hold_steps, int u
     else
         snprintf(settled, sizeof settled, "not within %.2f s", hold_steps * DT);
     printf("%s %s%s: kinetic energy peak %.3g J, %.3g J (%.2g of it) at the end; below 1e-6 of it "
-           "%s; tissue within %.1f mm of the skinned pose; bone tissues within %.4f mm of their "
-           "rigid motion; at most %d CG iterations\n",
+           "%s, at most %.2g of it after; tissue within %.1f mm of the skinned pose; bone tissues "
+           "within %.4f mm of their rigid motion; at most %d CG iterations\n",
            names[0], names[1], n > 2 ? " and the elbows" : "", r.peak, r.ke_end, r.ke_end / r.peak,
-           settled, r.lag * 1e3, r.bones * 1e3, r.cg_max);
+           settled, r.after / r.peak, r.lag * 1e3, r.bones * 1e3, r.cg_max);
     pose_state_free(skinned);
     pose_state_free(st);
     return r;
@@ -219,20 +222,27 @@ static void test_elbows_settle(void **state)
     assert_true(r.bones <= 1e-4);
 }
 
-/* Knees and elbows together, held 1 s: stable and bounded, bones rigid.
- * The tissue does not settle to 1e-6 here: soft tets that the coarse bake
- * strings between the two knees are turned inside out as the shanks fold,
- * and one of their vertices flips back and forth every step at about 1 m/s
- * (a two-step cycle; 1.5e-4 of the peak energy left after 20 s). Asserted:
- * what is left stays below 1e-3 of the peak, and no vertex is farther than
- * 20 cm from the skinned pose (15.9 cm measured, at those tets). */
-static void test_knees_bounded(void **state)
+/* Knees and elbows together, held 1 s: the tissue settles (kinetic energy
+ * below 1e-6 of its peak) within 1 s of the stop (0.84 s measured) and
+ * stays below 5e-5 of it (6.7e-6 measured), bones rigid, no vertex farther
+ * than 20 cm from the skinned pose. Soft tets the coarse bake strings
+ * between the knees are stretched and turned inside out as the shanks
+ * fold; before the stiffness took the rotation's derivative
+ * (fem_dyn_twist.h) one of their vertices flipped back and forth every
+ * step at about 1 m/s and 1.2e-4 of the peak was left after 1 s. What is
+ * left now (5e-7 to 7e-6 of the peak, a kick every 7 steps) is one vertex
+ * of a tet outside the skin at the left elbow, stretched 3.4 times and
+ * inverted, crossing the kink of the co-rotated energy where Irving's
+ * rotation changes branch: it varies with the flag threshold (1.7e-5 and
+ * 1.8e-5 of the peak at 24 and 32), hence the margin. */
+static void test_knees_settle(void **state)
 {
     (void)state;
     static const char *const names[4] = {"knee_r", "knee_l", "elbow_r", "elbow_l"};
     bend r = bend_and_hold(names, 4, 120, 0);
     assert_true(r.peak > 1.0);
-    assert_true(r.ke_end <= 1e-3 * r.peak);
+    assert_true(r.settled_s >= 0.0 && r.settled_s <= 1.0);
+    assert_true(r.after <= 5e-5 * r.peak);
     assert_true(r.lag <= 0.2);
     assert_true(r.bones <= 1e-4);
 }
@@ -275,7 +285,7 @@ int main(int argc, char **argv)
     const struct CMUnitTest all[] = {
         cmocka_unit_test(test_ramps_bones_rigid),
         cmocka_unit_test(test_elbows_settle),
-        cmocka_unit_test(test_knees_bounded),
+        cmocka_unit_test(test_knees_settle),
         cmocka_unit_test(test_threads),
     };
     const struct CMUnitTest threads[] = {cmocka_unit_test(test_threads)};
