@@ -239,14 +239,10 @@ void pose__state_transfer_task(void *ctx, unsigned part, unsigned parts)
     size_t b = pose__part_begin(mesh->block_count, part, parts);
     size_t e = pose__part_begin(mesh->block_count, part + 1, parts);
     uint32_t *flagged = st->flagged + b * POSE__BLOCK;
-    if (st->rigid_bones) /* state_bones.c */
-        st->flagged_count[part] = pose__state_transfer_soft(st, b, e, flagged);
-    else
-        st->flagged_count[part] = pose__transfer(mesh, st->tet_positions, b, e,
-                                                 st->tissue_positions, st->tissue_normals, flagged);
+    /* bone tissues by their joint, the others by the transfer (state_bones.c) */
+    st->flagged_count[part] = pose__state_transfer_soft(st, b, e, flagged);
     pose__state_place_outside(st, b * POSE__BLOCK, e * POSE__BLOCK); /* rig_outside.c */
-    if (st->rigid_bones)
-        pose__state_place_bones(st, b * POSE__BLOCK, e * POSE__BLOCK);
+    pose__state_place_bones(st, b * POSE__BLOCK, e * POSE__BLOCK);
 }
 
 /* Normals of the vertices in flat or inverted tets, from their triangles:
@@ -279,9 +275,8 @@ void pose__state_skin_pass(pose_state *st)
         pose__pool_run(st->pool, pose__state_skin_task, st);
 }
 
-void pose__state_transfer_pass(pose_state *st, int rigid_bones)
+void pose__state_transfer_pass(pose_state *st)
 {
-    st->rigid_bones = rigid_bones;
     if (serial_frame(st)) {
         pose__state_transfer_task(st, 0, 1);
         if (st->flagged_count[0] > 0)
@@ -309,12 +304,13 @@ pose_status pose_apply(pose_state *st)
         pose__state_fem_refine(st); /* state_fem.c */
         t0 = pose__seconds();
     }
-    /* Bone tissues follow their joint (state_bones.c) for POSE_FEM, whose
-     * refinement moves the soft tets that hold part of each bone surface,
-     * and for the contact response, which pushes skin out of each bone as
-     * its joint moves it (contact_push.c). Otherwise the skinning methods
-     * keep every tissue on their own field. */
-    pose__state_transfer_pass(st, st->method == POSE_FEM || st->push_enabled);
+    /* Bone tissues follow their joint rigidly (state_bones.c) with every
+     * method: the bake embeds part of each bone surface in soft tets (and
+     * at joints a few vertices in the next bone's), which the skinning
+     * bends and POSE_FEM's refinement moves (a femoral head 32 mm off its
+     * femur at hip flexion 90 through the transfer); the contact response
+     * pushes skin out of each bone as its joint moves it (contact_push.c). */
+    pose__state_transfer_pass(st);
     if (st->method == POSE_FEM)
         st->fem_stats.seconds_transfer = pose__seconds() - t0;
     pose__state_push(st); /* contact_push.c: skin out of bone, on the final positions */

@@ -1,6 +1,5 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* Bone tissues moved by their joint's rigid motion (POSE_FEM, dynamics,
- * the contact response).
+/* Bone tissues moved by their joint's rigid motion, with every method.
  *
  * The bake embeds a bone surface's vertices in whatever tet holds them: a
  * voxelized bone is not its mesh, so part of them lie in soft tets around
@@ -9,9 +8,10 @@
  * humerus' at the elbow: 32 and 25 mm from the bone's rigid motion at hip
  * flexion 90 and elbow flexion 120, with every method). The refinement and
  * the dynamics also move the soft tets (by up to 0.9 mm from rigid at the
- * bone surfaces under the dynamics' ramps). Both treat the bones as rigid
- * bodies, their tets' vertices held at, or sprung to, the skinned pose, so
- * a bone tissue of joint j is placed by j's skinning transform itself:
+ * bone surfaces under the dynamics' ramps). Bones are rigid bodies (and
+ * the simulation holds their tets' vertices at, or springs them to, the
+ * skinned pose), so a bone tissue of joint j is placed by j's skinning
+ * transform itself:
  * rest position and normal, rotated and moved, and the transfer skips the
  * blocks that hold bone vertices only. Vertex by vertex, as the transfer:
  * the same bits on any thread count. */

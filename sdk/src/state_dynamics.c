@@ -126,7 +126,7 @@ pose_status pose_reset_dynamics(pose_state *st)
         return s;
     if (!fresh)
         restart(st);
-    pose__state_transfer_pass(st, 1);
+    pose__state_transfer_pass(st);
     return POSE_OK;
 }
 
@@ -156,7 +156,7 @@ pose_status pose_step(pose_state *st, double dt)
                        &fs);
     memcpy(st->tet_positions, st->dyn.x, 3 * st->rig->tet_vertex_count * sizeof(float));
     const double t2 = pose__seconds();
-    pose__state_transfer_pass(st, 1);
+    pose__state_transfer_pass(st);
     ds->size = sizeof *ds;
     ds->islands = (int)st->dyn.island_count;
     ds->cg_iterations = fs.cg_iterations;

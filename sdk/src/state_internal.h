@@ -40,8 +40,6 @@ struct pose_state {
     uint32_t *flagged;          /**< tissue vertices whose normals come from triangles
                                      this frame; part p lists from its first vertex */
     size_t *flagged_count;      /**< per part (POSE__MAX_THREADS) */
-    int rigid_bones;            /**< this transfer places bone tissues by their joint
-                                     (POSE_FEM, dynamics: state_bones.c) */
 
     /* POSE_FEM (state_fem.c); work arrays only when the rig has a fem section */
     pose__fem_work fem_work;
@@ -91,9 +89,9 @@ double pose__seconds(void);
 void pose__state_fem_defaults(pose__fem_params *out);
 /** FK, skinning palette and skinning of the tet mesh into tet_positions. */
 void pose__state_skin_pass(pose_state *st);
-/** Transfer of tet_positions to the tissues (positions, normals); with
- *  rigid_bones, bone tissues follow their joint instead (state_bones.c). */
-void pose__state_transfer_pass(pose_state *st, int rigid_bones);
+/** Transfer of tet_positions to the tissues (positions, normals); bone
+ *  tissues follow their joint instead (state_bones.c). */
+void pose__state_transfer_pass(pose_state *st);
 /** The transfer (pose__transfer) of the blocks among [begin, end) that
  *  hold a vertex of a tissue other than a bone; flagged vertices listed
  *  from `flagged`, their count returned (state_bones.c). */

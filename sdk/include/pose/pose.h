@@ -554,7 +554,9 @@ POSE_API pose_status pose_set_threads(pose_state *state, int threads);
 
 /**
  * Pose the anatomy: forward kinematics, skinning of the tet mesh, transfer to
- * every tissue vertex, normals. Allocates nothing. @since 0.1
+ * every tissue vertex, normals. Bone tissues move rigidly with their joint
+ * (pose_tissue_info.joint; since 0.2, with every method), whatever the tets
+ * that hold their vertices do. Allocates nothing. @since 0.1
  */
 POSE_API pose_status pose_apply(pose_state *state);
 
