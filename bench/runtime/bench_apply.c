@@ -107,35 +107,6 @@ static void set_frame_pose(pose_state *st, size_t joints, int frame)
     }
 }
 
-/* The passes of pose_apply, split over the pool as sdk/src/state.c splits
- * them (same kernels, same ranges), for --passes. */
-static void pass_skin(void *ctx, unsigned part, unsigned parts)
-{
-    pose_state *st = ctx;
-    const pose__skin_mesh *m = &st->rt->skin;
-    pose__skin((int)st->method, m, st->palette, pose__part_begin(m->block_count, part, parts),
-               pose__part_begin(m->block_count, part + 1, parts), st->tet_positions);
-}
-
-static void pass_transfer(void *ctx, unsigned part, unsigned parts)
-{
-    pose_state *st = ctx;
-    const pose__transfer_mesh *m = &st->rt->transfer;
-    size_t b = pose__part_begin(m->block_count, part, parts);
-    st->flagged_count[part] =
-        pose__transfer(m, st->tet_positions, b, pose__part_begin(m->block_count, part + 1, parts),
-                       st->tissue_positions, st->tissue_normals, st->flagged + b * POSE__BLOCK);
-}
-
-static void pass_fix(void *ctx, unsigned part, unsigned parts)
-{
-    pose_state *st = ctx;
-    const pose__transfer_mesh *m = &st->rt->transfer;
-    size_t b = pose__part_begin(m->block_count, part, parts);
-    pose__transfer_fix_normals(m, st->tissue_positions, st->flagged + b * POSE__BLOCK,
-                               st->flagged_count[part], st->tissue_normals);
-}
-
 /* Mean seconds of pose_apply (out[3]) and of each of its passes (out[0..2])
  * over `frames` posed frames: pose_apply is timed, then its passes run
  * again, each timed (same machine state, so the shares compare). */
@@ -143,7 +114,9 @@ static void time_passes(pose_state *st, size_t joints, int frames, double out[4]
 {
     const size_t blocks = st->rt->skin.block_count + st->rt->transfer.block_count;
     const int serial = blocks < POSE__SERIAL_BLOCKS;
-    const pose__task_fn fns[3] = {pass_skin, pass_transfer, pass_fix};
+    /* pose_apply's own passes (sdk/src/state.c), for --passes */
+    const pose__task_fn fns[3] = {pose__state_skin_task, pose__state_transfer_task,
+                                  pose__state_fix_normals_task};
     out[0] = out[1] = out[2] = out[3] = 0.0;
     for (int f = 0; f < frames; f++) {
         set_frame_pose(st, joints, f);
