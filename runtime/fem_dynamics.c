@@ -297,11 +297,14 @@ static inline void vertex_block(const pose__fem_mesh *m, const uint32_t *off, co
     }
 }
 
-/* Zero-length spring stiffness of a bone node (0 for other vertices: held
- * vertices are the ones whose Jacobi weight the mesh left at zero). */
+/* Zero-length spring stiffness of a bone node (held vertices are the ones
+ * whose Jacobi weight the mesh left at zero), or of a coupled vertex (its
+ * target in `bones` too), else 0. */
 static inline float spring_of(const step_ctx *c, size_t v)
 {
-    return c->mesh->inv_diag[v] == 0.0f ? c->prm->coupling * c->d->stiff[v] : 0.0f;
+    return c->mesh->inv_diag[v] == 0.0f ? c->prm->coupling * c->d->stiff[v]
+           : c->prm->spring             ? c->prm->spring[v]
+                                        : 0.0f;
 }
 
 /* A vertex's dot product in double (the passes sum them in double). */

@@ -46,6 +46,10 @@ typedef struct pose__fem_dyn_params {
     float alpha;          /**< Rayleigh mass damping, 1/s */
     float beta;           /**< Rayleigh stiffness damping, s */
     float coupling;       /**< bone springs: multiple of each node's own elastic stiffness */
+    /** Couplings (pose.h pose_fem_coupling), or NULL: per vertex the
+     *  stiffness of a zero-length spring tying a simulated vertex to its
+     *  entry in `bones` (the coupling's target), damped as the bone nodes'. */
+    const float *spring;
     float tolerance;      /**< per island: stop at r^T P r <= tolerance^2 max(b^T P b, mm) */
     int cg_iterations;    /**< most CG iterations per island and step */
     float gravity[3];     /**< rig units / s^2 */

@@ -491,13 +491,18 @@ int pose__fem_invert_block(const double k[6], float out[6])
     return 0;
 }
 
-/* The inverse of vertex v's diagonal block (symmetric, 6 floats), or zero
- * for a held vertex. Falls back to the rotation-free diagonal when the
- * block is singular (a vertex of flat tets only). */
-static void vertex_preconditioner(const pose__fem_mesh *m, const float *dblk, size_t v, float *pre)
+/* The inverse of vertex v's diagonal block (symmetric, 6 floats; with its
+ * coupling spring ks), or zero for a held vertex. Falls back to the
+ * rotation-free diagonal when the block is singular (a vertex of flat tets
+ * only). */
+static void vertex_preconditioner(const pose__fem_mesh *m, const float *dblk, size_t v, float ks,
+                                  float *pre)
 {
     double k[6];
     pose__fem_vertex_block(m, dblk, v, k);
+    k[0] += ks;
+    k[3] += ks;
+    k[5] += ks;
     const float id = m->inv_diag[v];
     if (id == 0.0f || pose__fem_invert_block(k, pre) < 0) {
         pre[0] = pre[3] = pre[5] = id;
@@ -513,18 +518,24 @@ static void vertices_pass(solve_ctx *c, size_t chunk)
     if (e > m->vertex_count)
         e = m->vertex_count;
     double s0 = 0.0, s1 = 0.0, s2 = 0.0;
+    const float *spring = c->prm->spring;
     for (size_t v = b; v < e; v++) {
         const float id = m->inv_diag[v];
+        /* a coupling's zero-length spring (free vertices only) */
+        const float ks = spring && id > 0.0f ? spring[v] : 0.0f;
         float *r = w->r + 3 * v, *z = w->z + 3 * v, *p = w->p + 3 * v, *ap = w->ap + 3 * v;
         const float *gv = w->gvol + 3 * v;
         if (c->pass == PASS_GATHER_RESIDUAL) {
             float f[3];
             pose__fem_gather(m, w->corner, v, f);
             float *pre = w->pre + 6 * v;
-            vertex_preconditioner(m, w->dblk, v, pre);
+            vertex_preconditioner(m, w->dblk, v, ks, pre);
+            const float *xt = ks > 0.0f ? c->prm->target + 3 * v : NULL, *xv = c->x + 3 * v;
             for (int a = 0; a < 3; a++) {
                 r[a] = id > 0.0f ? f[a] + m->mass[v] * c->prm->gravity[a] + c->vol_force * gv[a]
                                  : 0.0f;
+                if (xt)
+                    r[a] += ks * (xt[a] - xv[a]);
                 p[a] = 0.0f;
             }
             pose__fem_apply_block(pre, r, z);
@@ -537,7 +548,7 @@ static void vertices_pass(solve_ctx *c, size_t chunk)
             pose__fem_gather(m, w->corner, v, f);
             for (int a = 0; a < 3; a++) {
                 p[a] = z[a] + c->beta * p[a];
-                ap[a] = id > 0.0f ? f[a] : 0.0f;
+                ap[a] = id > 0.0f ? f[a] + ks * p[a] : 0.0f;
                 s0 += (double)p[a] * ap[a];
                 s2 += (double)p[a] * gv[a];
             }

@@ -23,6 +23,11 @@ typedef struct pose__fem_params {
     int cg_iterations;     /**< most CG iterations per outer iteration */
     float tolerance;       /**< stop when |r| <= tolerance * |r| of the first outer iteration */
     float gravity[3];      /**< acceleration, rig units / s^2 */
+    /** Couplings (pose.h pose_fem_coupling), or NULL: per vertex the
+     *  stiffness of a zero-length spring pulling a free vertex toward
+     *  target (3 per vertex; read where spring > 0). */
+    const float *spring;
+    const float *target;
 } pose__fem_params;
 
 typedef struct pose__fem_stats {

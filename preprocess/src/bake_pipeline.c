@@ -83,6 +83,8 @@ typedef struct bake_state {
     pose_joint_desc *joints;
     pose_joint_clinical *clinical; /* NULL when the template has no clinical data */
     pose_tissue_desc *tissues;
+    pose_fem_coupling *couplings;  /* the template's, resolved (NULL: none) */
+    size_t coupling_count;
 } bake_state;
 
 static void bake_state_free(bake_state *s, const pp_bake_options *o, size_t tissue_count)
@@ -114,6 +116,7 @@ static void bake_state_free(bake_state *s, const pp_bake_options *o, size_t tiss
     free(s->joints);
     free(s->clinical);
     free(s->tissues);
+    free(s->couplings);
 }
 
 static int load_meshes(const pp_bake_options *o, bake_state *s, pp_bake_report *rep, char *err,
@@ -282,16 +285,25 @@ static int write_rig(const pp_bake_options *o, bake_state *s, pp_bake_report *re
         memcpy(d->limit_min_deg, tj->limit_min_deg, sizeof d->limit_min_deg);
         memcpy(d->limit_max_deg, tj->limit_max_deg, sizeof d->limit_max_deg);
     }
-    char meta[1024], neutral[256] = "";
+    char meta[1024], neutral[256] = "", coupled[128] = "";
     int clinical = clinical_desc(rep, s, neutral, sizeof neutral);
     if (clinical < 0)
         return pp_fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
+    if (!o->no_fem && t->coupling_count) {
+        int rc = pp_bake_couplings(t, s->bones, s->bone_joint, o->bone_count, &s->tet,
+                                   &s->couplings, &s->coupling_count, err, n);
+        if (rc < 0)
+            return rc;
+        rep->coupled_nodes = s->coupling_count;
+        snprintf(coupled, sizeof coupled, "; %zu nodes coupled to bones (%zu template couplings)",
+                 s->coupling_count, t->coupling_count);
+    }
     snprintf(meta, sizeof meta,
              "pose-bake %s; template %s (%s); skin %s; %zu bones; voxel %.2f mm; backend %s; "
-             "K %u; %zu tet vertices, %zu tets%s",
+             "K %u; %zu tet vertices, %zu tets%s%s",
              pose_version_string(), t->name, o->template_path, o->skin_path, o->bone_count,
              (double)rep->voxel_mm, pp_tet_backend_name(o->backend), s->w.influences,
-             s->tet.vertex_count, s->tet.tet_count, neutral);
+             s->tet.vertex_count, s->tet.tet_count, neutral, coupled);
     /* POSE_FEM simulates the rig's own tets (bone labels rigid): all it
      * needs stored is the soft tissue's material. */
     const pose_fem_material fem = {
@@ -303,7 +315,8 @@ static int write_rig(const pp_bake_options *o, bake_state *s, pp_bake_report *re
                           s->tet.labels,      s->w.influences, s->w.joints,
                           s->w.weights,       s->cor,        rep->tissue_count,
                           s->tissues,         meta,          s->clinical,
-                          o->no_fem ? NULL : &fem, o->volume_count, o->volumes};
+                          o->no_fem ? NULL : &fem, o->volume_count, o->volumes,
+                          s->coupling_count,  s->couplings};
     /* Write beside the target, then rename: a reader never sees half a rig. */
     size_t len = strlen(o->output_path) + 32;
     char *tmp = malloc(len);

@@ -97,6 +97,7 @@ typedef struct pp_bake_report {
     size_t tissue_count;
     pp_cor_report cor;
     size_t soft_bones;             /**< bone files not in the template (kept as soft tissue) */
+    size_t coupled_nodes;          /**< simulation nodes the template's couplings tie to bones */
     size_t rig_bytes;
 } pp_bake_report;
 
@@ -108,6 +109,18 @@ typedef struct pp_bake_report {
  */
 int pp_bake(const pp_bake_options *opt, pp_bake_report *report, char *err, size_t err_size);
 void pp_bake_report_free(pp_bake_report *r);
+
+/**
+ * The template's "couplings" resolved on the tet mesh (bake_couplings.c):
+ * every soft node (in a soft tet and in no bone tet) within an entry's
+ * reach_mm of its bone meshes' surface (bone_joint: each mesh's joint or
+ * -1), anchored at its rest position; the nearest bone wins. *out sorted by
+ * node (malloc'd; NULL when none). An entry whose bone meshes were not
+ * given is an error naming it.
+ */
+int pp_bake_couplings(const pp_template *t, const pp_mesh *bones, const int *bone_joint,
+                      size_t bone_count, const pp_tetmesh *tet, pose_fem_coupling **out,
+                      size_t *count, char *err, size_t err_size);
 
 /** The report as JSON text (cJSON; caller frees with free()), or NULL. */
 char *pp_bake_report_json(const pp_bake_report *r, const pp_bake_options *opt);

@@ -451,6 +451,67 @@ static int parse_joint(const parse_ctx *c, const cJSON *obj, size_t index, pp_te
     return POSE_OK;
 }
 
+/* One "couplings" entry (after the joints: it names them or their bones). */
+static int parse_coupling(const parse_ctx *c, const cJSON *obj, size_t index, pp_template *t)
+{
+    pp_template_coupling *k = &t->couplings[index];
+    if (!cJSON_IsObject(obj))
+        return fail_at(c, POSE_ERR_FORMAT, NULL, "couplings[%zu] must be an object", index);
+    if (repeated_key(obj))
+        return fail_at(c, POSE_ERR_FORMAT, NULL, "couplings[%zu]: key '%s' appears twice", index,
+                       repeated_key(obj));
+    k->joint = -1;
+    k->stiffness = PP_COUPLING_STIFFNESS;
+    int have_reach = 0, named = 0;
+    for (const cJSON *e = obj->child; e; e = e->next) {
+        const char *key = e->string;
+        if (strcmp(key, "bone") == 0 || strcmp(key, "joint") == 0) {
+            const int bone = key[0] == 'b';
+            if (named++)
+                return fail_at(c, POSE_ERR_FORMAT, NULL,
+                               "couplings[%zu]: give either 'bone' or 'joint', not both", index);
+            if (!cJSON_IsString(e) || !valid_name(e->valuestring))
+                return fail_at(c, POSE_ERR_FORMAT, NULL,
+                               "couplings[%zu]: '%s' must be a name of 1..63 bytes", index, key);
+            k->joint = bone ? pp_template_joint_of_bone(t, e->valuestring)
+                            : pp_template_find_joint(t, e->valuestring);
+            if (k->joint < 0)
+                return fail_at(c, POSE_ERR_INVALID_DATA, NULL,
+                               bone ? "couplings[%zu]: bone '%s' is in no joint's 'bones'"
+                                    : "couplings[%zu]: joint '%s' is not in 'joints'",
+                               index, e->valuestring);
+            if (bone)
+                strcpy(k->bone, e->valuestring);
+        } else if (strcmp(key, "reach_mm") == 0) {
+            if (!cJSON_IsNumber(e) || !(e->valuedouble > 0.0 && e->valuedouble <= 100.0))
+                return fail_at(c, POSE_ERR_FORMAT, NULL,
+                               "couplings[%zu]: 'reach_mm' must be a number in (0, 100]", index);
+            k->reach_mm = (float)e->valuedouble;
+            have_reach = 1;
+        } else if (strcmp(key, "stiffness") == 0) {
+            if (!cJSON_IsNumber(e) || !(e->valuedouble > 0.0 && e->valuedouble <= 1e6))
+                return fail_at(c, POSE_ERR_FORMAT, NULL,
+                               "couplings[%zu]: 'stiffness' must be a number in (0, 1e6] (a "
+                               "multiple of the node's own elastic stiffness)", index);
+            k->stiffness = (float)e->valuedouble;
+        } else if (strcmp(key, "comment") != 0) {
+            return fail_at(c, POSE_ERR_FORMAT, NULL,
+                           "couplings[%zu]: unknown key '%s' (expected bone or joint, reach_mm, "
+                           "stiffness, comment)", index, key);
+        }
+    }
+    if (!named || !have_reach)
+        return fail_at(c, POSE_ERR_FORMAT, NULL, "couplings[%zu]: needs 'bone' or 'joint', and 'reach_mm'",
+                       index);
+    for (size_t i = 0; i < index; i++)
+        if (t->couplings[i].joint == k->joint && strcmp(t->couplings[i].bone, k->bone) == 0)
+            return fail_at(c, POSE_ERR_INVALID_DATA, NULL,
+                           "couplings[%zu]: the same %s '%s' as couplings[%zu]", index,
+                           k->bone[0] ? "bone" : "joint",
+                           k->bone[0] ? k->bone : t->joints[k->joint].name, i);
+    return POSE_OK;
+}
+
 int pp_template_parse(const char *text, size_t size, const char *source, pp_template *out,
                       char *err, size_t err_size)
 {
@@ -488,7 +549,7 @@ int pp_template_parse(const char *text, size_t size, const char *source, pp_temp
         goto done;
     }
     float contact_mm = 4.0f;
-    const cJSON *joints = NULL;
+    const cJSON *joints = NULL, *couplings = NULL;
     for (const cJSON *e = root->child; e; e = e->next) {
         if (strcmp(e->string, "format") == 0 || strcmp(e->string, "version") == 0 ||
             strcmp(e->string, "comment") == 0 || strcmp(e->string, "description") == 0) {
@@ -507,6 +568,8 @@ int pp_template_parse(const char *text, size_t size, const char *source, pp_temp
             contact_mm = (float)e->valuedouble;
         } else if (strcmp(e->string, "joints") == 0) {
             joints = e;
+        } else if (strcmp(e->string, "couplings") == 0) {
+            couplings = e;
         } else {
             rc = fail_at(&c, POSE_ERR_FORMAT, NULL, "unknown top-level key '%s'", e->string);
             goto done;
@@ -532,6 +595,26 @@ int pp_template_parse(const char *text, size_t size, const char *source, pp_temp
         rc = parse_joint(&c, e, i, out, contact_mm);
         if (rc < 0)
             goto done;
+    }
+    if (couplings) {
+        const size_t nc = cJSON_IsArray(couplings) ? (size_t)cJSON_GetArraySize(couplings) : 0;
+        if (!cJSON_IsArray(couplings) || nc > 1024) {
+            rc = fail_at(&c, POSE_ERR_FORMAT, NULL, "'couplings' must be an array of at most 1024 "
+                         "entries");
+            goto done;
+        }
+        out->couplings = calloc(nc ? nc : 1, sizeof *out->couplings);
+        if (!out->couplings) {
+            rc = fail_at(&c, POSE_ERR_OUT_OF_MEMORY, NULL, "out of memory");
+            goto done;
+        }
+        i = 0;
+        for (const cJSON *e = couplings->child; e; e = e->next, i++) {
+            rc = parse_coupling(&c, e, i, out);
+            if (rc < 0)
+                goto done;
+            out->coupling_count = i + 1;
+        }
     }
 done:
     cJSON_Delete(root);
@@ -579,6 +662,7 @@ void pp_template_free(pp_template *t)
         free(t->joints[i].parent_contact);
     }
     free(t->joints);
+    free(t->couplings);
     memset(t, 0, sizeof *t);
 }
 

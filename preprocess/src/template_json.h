@@ -20,8 +20,24 @@
  *       "at": [x, y, z],                    fixed centre (rule fixed; root optional)
  *       "limits": {"order": "XYZ", "y": [0, 150]},  degrees about frame axes
  *       "clinical": { ... },                optional, see below (not on the root)
+ *       "comment": "..." } ],
+ *     "couplings": [ {                      optional: soft tissue tethered to bone
+ *       "bone": "r_tibia",                  a bone mesh of some joint's "bones", or
+ *       "joint": "knee_r",                  every bone mesh of that joint's segment
+ *       "reach_mm": 12,                     simulation nodes within this distance of
+ *                                           the bone's surface, (0, 100] millimetres
+ *       "stiffness": 100,                   optional: multiple of each node's own elastic
+ *                                           stiffness, (0, 1e6], default 100
  *       "comment": "..." } ] }
  * Unknown or repeated keys are errors, so typos do not pass silently.
+ *
+ * "couplings" (Otaduy et al. §4.2, §5.2): pose-bake ties every soft
+ * simulation node (a tet vertex in soft tissue, not a bone tet's) within
+ * reach of the named bone's surface to that bone's rigid motion by a
+ * zero-length spring (the rig's `couplings` section; pose.h
+ * pose_fem_coupling): skin over the shin, the sternum, the skull, the
+ * iliac crest, the olecranon. A node within reach of several entries takes
+ * the nearest bone.
  *
  * "clinical" describes the joint's clinical angles (design §2b, pose.h
  * pose_joint_clinical) in model space, in the anatomical neutral posture:
@@ -106,10 +122,23 @@ typedef struct pp_template_joint {
     pp_template_clinical clinical;
 } pp_template_joint;
 
+/** A "couplings" entry. */
+typedef struct pp_template_coupling {
+    char bone[PP_NAME_MAX];     /**< a bone mesh, or "" for every bone of the joint */
+    int joint;                  /**< the joint whose rigid motion the nodes follow */
+    float reach_mm;             /**< (0, 100] */
+    float stiffness;            /**< (0, 1e6]: multiple of a node's own elastic stiffness */
+} pp_template_coupling;
+
+/** A coupling's default stiffness: the bone nodes' (pose_dynamics_defaults). */
+#define PP_COUPLING_STIFFNESS 100.0f
+
 typedef struct pp_template {
     char name[PP_NAME_MAX];
     size_t joint_count;
     pp_template_joint *joints;
+    size_t coupling_count;
+    pp_template_coupling *couplings;
 } pp_template;
 
 /**

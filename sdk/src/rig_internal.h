@@ -57,6 +57,18 @@ typedef struct pose__fem_record {
 } pose__fem_record;
 _Static_assert(sizeof(pose__fem_record) == 64, "fem record is 64 bytes on disk");
 
+/** One coupling as stored in the optional `couplings` section (32 bytes,
+ *  little-endian; docs/rig-format.md). */
+typedef struct pose__coupling_record {
+    uint32_t node;        /* < tet vertices, strictly increasing */
+    uint32_t joint;       /* < joints */
+    float stiffness;      /* finite, > 0 */
+    uint32_t flags;       /* 0 */
+    float anchor[3];      /* finite */
+    uint32_t reserved;    /* 0 */
+} pose__coupling_record;
+_Static_assert(sizeof(pose__coupling_record) == 32, "coupling record is 32 bytes on disk");
+
 /** One tissue surface; arrays point into the rig's storage. */
 typedef struct pose__tissue {
     const char *name;         /* NUL-terminated, < POSE__NAME_SIZE bytes */
@@ -89,6 +101,8 @@ struct pose_rig {
     const pose__joint_limit *joint_limits;
     const pose__clinical_record *clinical; /* joint_count records, or NULL (no section) */
     const pose__fem_record *fem;           /* soft tissue material, or NULL (no POSE_FEM) */
+    const pose__coupling_record *couplings;/* coupling_count records, or NULL (no section) */
+    size_t coupling_count;
     const uint8_t *volumes;                /* the volumes section (checked), or NULL */
     uint32_t volume_count;
 

@@ -60,6 +60,9 @@ pose_status pose__rig_validate(const pose_rig *rig, const pose__source *src);
 pose_status pose__clinical_validate(const pose_rig *rig, const pose__source *src);
 /** The fem section's material record (when present): finite, in range. */
 pose_status pose__fem_validate(const pose_rig *rig, const pose__source *src);
+/** The couplings section's records: nodes and joints in range, nodes
+ *  strictly increasing, values finite, reserved bytes zero; needs `fem`. */
+pose_status pose__couplings_validate(const pose_rig *rig, const pose__source *src);
 
 /** Map and check the volumes section (bytes p .. p + size of src) into
  *  rig->volumes (rig_volumes.c). */

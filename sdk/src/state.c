@@ -167,6 +167,11 @@ pose_status pose_state_create_ex(const pose_rig *rig, const pose_state_options *
         pose__free(&alloc, block);
         return s;
     }
+    s = pose__state_couplings_init(st); /* state_coupling.c: the rig's couplings */
+    if (s < 0) {
+        pose_state_free(st);
+        return s;
+    }
     *out = st;
     return POSE_OK;
 }
@@ -183,6 +188,7 @@ void pose_state_free(pose_state *st)
         pose__free(&alloc, st->pool);
     }
     pose__state_push_free(st);
+    pose__state_couplings_free(st);
     pose__free(&alloc, st->block);
 }
 

@@ -42,6 +42,7 @@ static pose_status check_rig(const pose_state *st, const char *fn)
 static void restart(pose_state *st)
 {
     pose__state_skin_pass(st);
+    pose__state_couplings_bones(st); /* coupled nodes start at their springs' ends */
     pose__fem_dyn_reset(&st->rt->fem, &st->dyn, st->tet_positions);
     memset(&st->dyn_stats, 0, sizeof st->dyn_stats);
     st->dyn_stats.size = sizeof st->dyn_stats;
@@ -141,7 +142,7 @@ pose_status pose_step(pose_state *st, double dt)
     if (s < 0)
         return s;
     const pose_dynamics_options *o = &st->dyn_options;
-    const pose__fem_dyn_params prm = {
+    pose__fem_dyn_params prm = {
         .dt = (float)dt, .alpha = o->mass_damping, .beta = o->stiffness_damping,
         .coupling = o->coupling_stiffness, .tolerance = o->tolerance,
         .cg_iterations = o->cg_iterations,
@@ -150,6 +151,7 @@ pose_status pose_step(pose_state *st, double dt)
     pose_dynamics_stats *ds = &st->dyn_stats;
     const double t0 = pose__seconds();
     pose__state_skin_pass(st); /* the bones' positions at the end of the step */
+    prm.spring = pose__state_couplings_bones(st); /* and the couplings' (state_coupling.c) */
     const double t1 = pose__seconds();
     pose__fem_dyn_stats fs;
     pose__fem_dyn_step(&st->rt->fem, &st->fem_work, &st->dyn, st->pool, &prm, st->tet_positions,

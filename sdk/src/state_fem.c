@@ -84,7 +84,10 @@ pose_status pose_get_fem_stats(const pose_state *st, pose_fem_stats *out)
 void pose__state_fem_refine(pose_state *st)
 {
     pose__fem_stats s;
-    pose__fem_solve(&st->rt->fem, &st->fem_work, st->pool, &st->fem_params, st->tet_positions, &s);
+    pose__fem_params prm = st->fem_params;
+    prm.spring = pose__state_couplings_place(st); /* state_coupling.c; NULL without */
+    prm.target = st->cpl_target;
+    pose__fem_solve(&st->rt->fem, &st->fem_work, st->pool, &prm, st->tet_positions, &s);
     st->fem_stats.outer_iterations = s.outer_iterations;
     st->fem_stats.cg_iterations = s.cg_iterations;
     st->fem_stats.residual = s.residual;

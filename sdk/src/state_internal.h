@@ -51,6 +51,13 @@ struct pose_state {
     pose_dynamics_options dyn_options;
     pose_dynamics_stats dyn_stats;
 
+    /* Couplings (state_coupling.c): own allocation, NULL when none is in effect */
+    void *cpl_block;
+    size_t cpl_count;           /**< couplings in effect (on nodes the simulation moves) */
+    uint32_t *cpl_node, *cpl_joint; /**< cpl_count each */
+    float *cpl_anchor;          /**< 3 per coupling: rest model space */
+    float *cpl_spring;          /**< per tet vertex: spring stiffness (0: not coupled) */
+    float *cpl_target;          /**< 3 per tet vertex: the spring's bone end this frame */
     struct pose__push *push;    /**< pose_set_contact_response (contact_push.c): own
                                      allocations, NULL until first enabled */
     int push_enabled;
@@ -99,6 +106,17 @@ size_t pose__state_transfer_soft(pose_state *st, size_t begin, size_t end, uint3
 /** Bone tissues' vertices among tissue vertices [begin, end) placed by
  *  their joint's skinning transform (positions and normals). */
 void pose__state_place_bones(pose_state *st, size_t begin, size_t end);
+/** A new state's couplings: the rig's (state_coupling.c). */
+pose_status pose__state_couplings_init(pose_state *st);
+void pose__state_couplings_free(pose_state *st);
+/** Where each coupling's bone end is after the skin pass (st->skin):
+ *  cpl_target at the coupled nodes; returns cpl_spring, or NULL when no
+ *  coupling is in effect. */
+const float *pose__state_couplings_place(pose_state *st);
+/** pose__state_couplings_place, and the targets copied into
+ *  st->tet_positions at the coupled nodes (the dynamics' springs pull
+ *  toward `bones`). */
+const float *pose__state_couplings_bones(pose_state *st);
 /** pose_apply's FEM refinement of st->tet_positions (after skinning). */
 void pose__state_fem_refine(pose_state *st);
 

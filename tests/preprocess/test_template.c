@@ -15,6 +15,9 @@
 
 #define HEAD "{\"format\": \"pose-skeleton-template\", \"version\": 1, \"joints\": [\n"
 #define ROOT "{\"name\": \"pelvis\", \"parent\": null, \"rule\": \"root\", \"bones\": [\"p\"]}"
+/* The root and a knee, then a "couplings" array (its entries follow). */
+#define KNEE HEAD ROOT ",\n{\"name\": \"knee\", \"parent\": \"pelvis\", \"rule\": \"hinge\", " \
+             "\"bones\": [\"tibia\", \"fibula\"]}],\n\"couplings\": ["
 
 typedef struct bad_case {
     const char *text;
@@ -130,6 +133,28 @@ static void test_rejects_malformed(void **state)
                    "\"clinical\": {\"flexion\": [0, 1, 0], \"abduction\": [1, 0, 0], \"rotation\": 1, "
                    "\"rotation\": -1}}]}",
          POSE_ERR_FORMAT, "joint 'hip': key 'clinical.rotation' appears twice"},
+        {KNEE "{\"bone\": \"femur\", \"reach_mm\": 10}]}", POSE_ERR_INVALID_DATA,
+         "t.json: couplings[0]: bone 'femur' is in no joint's 'bones'"},
+        {KNEE "{\"joint\": \"knee\", \"reach_mm\": 10}, {\"joint\": \"hip\", \"reach_mm\": 5}]}",
+         POSE_ERR_INVALID_DATA, "t.json: couplings[1]: joint 'hip' is not in 'joints'"},
+        {KNEE "{\"bone\": \"tibia\", \"joint\": \"knee\", \"reach_mm\": 10}]}", POSE_ERR_FORMAT,
+         "couplings[0]: give either 'bone' or 'joint', not both"},
+        {KNEE "{\"bone\": \"tibia\"}]}", POSE_ERR_FORMAT,
+         "couplings[0]: needs 'bone' or 'joint', and 'reach_mm'"},
+        {KNEE "{\"bone\": \"tibia\", \"reach_mm\": 0}]}", POSE_ERR_FORMAT,
+         "couplings[0]: 'reach_mm' must be a number in (0, 100]"},
+        {KNEE "{\"bone\": \"tibia\", \"reach_mm\": 120}]}", POSE_ERR_FORMAT,
+         "couplings[0]: 'reach_mm' must be a number in (0, 100]"},
+        {KNEE "{\"bone\": \"tibia\", \"reach_mm\": 8, \"stiffness\": -3}]}", POSE_ERR_FORMAT,
+         "couplings[0]: 'stiffness' must be a number in (0, 1e6]"},
+        {KNEE "{\"bone\": \"tibia\", \"reach_mm\": 8, \"soft\": \"skin\"}]}", POSE_ERR_FORMAT,
+         "couplings[0]: unknown key 'soft'"},
+        {KNEE "{\"bone\": \"tibia\", \"reach_mm\": 8, \"reach_mm\": 9}]}", POSE_ERR_FORMAT,
+         "couplings[0]: key 'reach_mm' appears twice"},
+        {KNEE "{\"bone\": \"tibia\", \"reach_mm\": 8}, {\"bone\": \"tibia\", \"reach_mm\": 3}]}",
+         POSE_ERR_INVALID_DATA, "couplings[1]: the same bone 'tibia' as couplings[0]"},
+        {KNEE "7]}", POSE_ERR_FORMAT, "couplings[0] must be an object"},
+        {HEAD ROOT "], \"couplings\": {}}", POSE_ERR_FORMAT, "'couplings' must be an array"},
         {HEAD "{\"name\": \"0123456789012345678901234567890123456789012345678901234567890123\", "
               "\"rule\": \"root\", \"bones\": [\"p\"]}]}",
          POSE_ERR_FORMAT, "'name' must be a string of 1..63 bytes"},
@@ -143,7 +168,38 @@ static void test_rejects_malformed(void **state)
                      cases[i].status, cases[i].message);
         assert_int_equal(t.joint_count, 0);
         assert_null(t.joints);
+        assert_int_equal(t.coupling_count, 0);
+        assert_null(t.couplings);
     }
+}
+
+/* "couplings": a bone or a joint's whole segment, reach, stiffness (default 100). */
+static void test_reads_couplings(void **state)
+{
+    (void)state;
+    const char *text = KNEE "{\"bone\": \"tibia\", \"reach_mm\": 12.5, \"comment\": \"shin\"},\n"
+                            "{\"joint\": \"knee\", \"reach_mm\": 3, \"stiffness\": 20},\n"
+                            "{\"bone\": \"p\", \"reach_mm\": 100, \"stiffness\": 1e6}]}";
+    pp_template t;
+    char err[512];
+    if (pp_template_parse(text, strlen(text), "t.json", &t, err, sizeof err) != POSE_OK)
+        fail_msg("%s", err);
+    assert_int_equal(t.coupling_count, 3);
+    assert_string_equal(t.couplings[0].bone, "tibia");
+    assert_int_equal(t.couplings[0].joint, 1);
+    assert_true(t.couplings[0].reach_mm == 12.5f && t.couplings[0].stiffness == 100.0f);
+    assert_string_equal(t.couplings[1].bone, ""); /* the whole segment */
+    assert_int_equal(t.couplings[1].joint, 1);
+    assert_true(t.couplings[1].reach_mm == 3.0f && t.couplings[1].stiffness == 20.0f);
+    assert_int_equal(t.couplings[2].joint, 0);
+    assert_true(t.couplings[2].stiffness == 1e6f);
+    pp_template_free(&t);
+    assert_int_equal(t.coupling_count, 0);
+    /* an empty array: no couplings */
+    const char *none = KNEE "]}";
+    assert_int_equal(pp_template_parse(none, strlen(none), "t.json", &t, err, sizeof err), POSE_OK);
+    assert_int_equal(t.coupling_count, 0);
+    pp_template_free(&t);
 }
 
 static void test_missing_file(void **state)
@@ -257,6 +313,7 @@ int main(void)
         cmocka_unit_test(test_missing_file),
         cmocka_unit_test(test_reads_minimal),
         cmocka_unit_test(test_reads_clinical),
+        cmocka_unit_test(test_reads_couplings),
         cmocka_unit_test(test_full_body_template),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -543,7 +543,7 @@ static void test_section_table_entries(void **state)
     memcpy(img, im.data, im.size);
     memset(img + im.size, 0x5A, 64);
     uint8_t *e = rb_entry(img, 5);
-    rb_put_u32(e, 10); /* reserved for future pose sections: unknown here */
+    rb_put_u32(e, 11); /* reserved for future pose sections: unknown here */
     rb_put_u32(e + 4, 1);
     rb_put_u64(e + 8, im.size);
     rb_put_u64(e + 16, 64);
@@ -1107,6 +1107,103 @@ static void test_clinical_description_errors(void **state)
     pose_rig_free(rig);
 }
 
+/* The couplings section (type 10, optional): round trip, what a state
+ * makes of it, damage named with its byte, and rigs without it. */
+static void test_couplings(void **state)
+{
+    (void)state;
+    tiny_rig t;
+    tiny_rig_init(&t, 1, 1);
+    tiny_rig_add_couplings(&t);
+    image im = write_image(&t.desc);
+    int e = rb_find(im.data, SEC_COUPLINGS);
+    assert_true(e >= 0);
+    assert_int_equal(rb_u32(rb_entry(im.data, (uint32_t)e) + 4), 1); /* OPTIONAL: 0.1 skips it */
+    assert_int_equal(rb_u64(rb_entry(im.data, (uint32_t)e) + 16), 64 + 64);
+    const uint64_t sec = rb_offset(im.data, SEC_COUPLINGS), r1 = sec + 64 + 32;
+    assert_int_equal(rb_u32(im.data + sec), 2);
+    pose_rig *rig;
+    assert_int_equal(pose_rig_load_memory(im.data, im.size, NULL, &rig), POSE_OK);
+    pose_fem_coupling got[3];
+    assert_int_equal(pose_rig_fem_couplings(rig, NULL, 0), 2);
+    assert_int_equal(pose_rig_fem_couplings(rig, got, 3), 2);
+    assert_memory_equal(got, t.couplings, sizeof t.couplings);
+    /* A state takes the rig's couplings on the nodes the simulation moves:
+     * vertices 9 and 10 are in soft tets only. */
+    pose_state *st;
+    assert_int_equal(pose_state_create(rig, &st), POSE_OK);
+    assert_int_equal(pose_fem_coupling_count(st), 2);
+    pose_state_free(st);
+    pose_rig_free(rig);
+    assert_int_equal(pose_rig_fem_couplings(NULL, got, 3), 0);
+
+    uint8_t *keep = malloc(im.size);
+    assert_non_null(keep);
+    memcpy(keep, im.data, im.size);
+    rb_put_u32(im.data + r1, 12); /* node */
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 3, "section 'couplings'",
+                      "coupling 1: node 12 is not a tet vertex (12)", at(r1));
+    memcpy(im.data, keep, im.size);
+    rb_put_u32(im.data + r1, 9); /* node 9 twice */
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 2, "node 9 after node 9", at(r1));
+    memcpy(im.data, keep, im.size);
+    rb_put_u32(im.data + r1 + 4, 3); /* joint */
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 2, "coupling 1: joint 3", at(r1 + 4));
+    memcpy(im.data, keep, im.size);
+    put_f32(&im, r1 + 8, -1.0f);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 2, "stiffness -1", at(r1 + 8));
+    memcpy(im.data, keep, im.size);
+    put_f32(&im, r1 + 20, NAN);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 2, "anchor is not finite",
+                      at(r1 + 20));
+    memcpy(im.data, keep, im.size);
+    rb_put_u32(im.data + r1 + 12, 1); /* flags */
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 2, "flags and reserved", at(r1 + 12));
+    memcpy(im.data, keep, im.size);
+    rb_put_u32(im.data + sec, 3); /* count: the size no longer matches */
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_FORMAT, 1, "section 'couplings'");
+    memcpy(im.data, keep, im.size);
+    rb_put_u32(im.data + sec, 0);
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_FORMAT, 2, "0 couplings", at(sec));
+    free(keep);
+    free(im.data);
+
+    /* Descriptions: couplings need fem; the checks run on pose_rig_create. */
+    t.desc.fem = NULL;
+    assert_int_equal(pose_rig_create(&t.desc, NULL, &rig), POSE_ERR_INVALID_ARGUMENT);
+    t.desc.fem = &t.fem;
+    t.couplings[1].node = 9;
+    assert_int_equal(pose_rig_create(&t.desc, NULL, &rig), POSE_ERR_INVALID_DATA);
+    assert_non_null(strstr(pose_last_error(), "node 9 after node 9"));
+
+    /* Without couplings: no section; the committed 0.1 seeds have none. */
+    tiny_rig_init(&t, 1, 1);
+    im = write_image(&t.desc);
+    assert_int_equal(rb_find(im.data, SEC_COUPLINGS), -1);
+    free(im.data);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/valid_tiny_full.rig", POSE_RIG_CORPUS);
+    assert_int_equal(pose_rig_load(path, &rig), POSE_OK);
+    assert_int_equal(pose_rig_fem_couplings(rig, got, 3), 0);
+    pose_rig_free(rig);
+    /* the committed seeds with the section (tests/rigfile/make_seeds.c) */
+    snprintf(path, sizeof path, "%s/valid_tiny_couplings.rig", POSE_RIG_CORPUS);
+    assert_int_equal(pose_rig_load(path, &rig), POSE_OK);
+    assert_int_equal(pose_rig_fem_couplings(rig, got, 3), 2);
+    pose_rig_free(rig);
+    snprintf(path, sizeof path, "%s/bad_coupling_node.rig", POSE_RIG_CORPUS);
+    rig = (pose_rig *)1;
+    assert_int_equal(pose_rig_load(path, &rig), POSE_ERR_INVALID_DATA);
+    assert_null(rig);
+    assert_non_null(strstr(pose_last_error(), "node 12 is not a tet vertex"));
+}
+
 static void test_status_strings_and_version(void **state)
 {
     (void)state;
@@ -1148,6 +1245,7 @@ int main(void)
         cmocka_unit_test(test_clinical_old_rigs_load),
         cmocka_unit_test(test_clinical_damage),
         cmocka_unit_test(test_clinical_description_errors),
+        cmocka_unit_test(test_couplings),
         cmocka_unit_test(test_status_strings_and_version),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -137,3 +137,17 @@ void tiny_rig_add_clinical(tiny_rig *t)
     t->clinical[0].limit_max_deg[0] = 99.0f;
     t->desc.clinical = t->clinical;
 }
+
+void tiny_rig_add_couplings(tiny_rig *t)
+{
+    t->fem = (pose_fem_material){1e4f, 0.45f, 1000.0f};
+    t->couplings[0] = (pose_fem_coupling){.node = 9, .joint = 1, .stiffness = 100.0f};
+    t->couplings[1] = (pose_fem_coupling){.node = 10, .joint = 2, .stiffness = 2.5f};
+    for (int k = 0; k < 2; k++)
+        memcpy(t->couplings[k].anchor, t->tet_positions + 3 * t->couplings[k].node,
+               sizeof t->couplings[k].anchor);
+    t->couplings[1].anchor[2] += 0.25f; /* an anchor off the node's rest position */
+    t->desc.fem = &t->fem;
+    t->desc.fem_coupling_count = 2;
+    t->desc.fem_couplings = t->couplings;
+}

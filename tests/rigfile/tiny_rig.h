@@ -25,6 +25,8 @@ typedef struct tiny_rig {
     uint32_t bone_tet[3];
     float bone_bary[3 * 4];
     pose_joint_clinical clinical[3];
+    pose_fem_material fem;
+    pose_fem_coupling couplings[2];
     pose_rig_desc desc;
 } tiny_rig;
 
@@ -34,5 +36,9 @@ void tiny_rig_init(tiny_rig *t, int with_cor, int with_metadata);
  *  a 30-degree neutral, right-handed axes, default names and two limited
  *  angles, wrist with left-handed axes, its own names and three limits. */
 void tiny_rig_add_clinical(tiny_rig *t);
+
+/** Add the optional fem and couplings sections: two soft nodes (vertices 9
+ *  and 10, of cube 1) tied to the elbow and the wrist. */
+void tiny_rig_add_couplings(tiny_rig *t);
 
 #endif /* POSE_TEST_TINY_RIG_H */

@@ -437,6 +437,11 @@ typedef struct pose_rig_desc {
      *  section. @since 0.2 */
     size_t volume_count;
     const struct pose_rig_volume *volumes;
+    /** Soft nodes tied to bones by zero-length springs (struct
+     *  pose_fem_coupling), fem_coupling_count entries sorted by node, or 0 /
+     *  NULL. Stored in the optional `couplings` section; needs `fem`. @since 0.2 */
+    size_t fem_coupling_count;
+    const struct pose_fem_coupling *fem_couplings;
 } pose_rig_desc;
 
 /**
@@ -717,6 +722,65 @@ POSE_API pose_status pose_step(pose_state *state, double dt);
 POSE_API pose_status pose_reset_dynamics(pose_state *state);
 /** Statistics of the last pose_step (zeros before one); out->size must be set. @since 0.2 */
 POSE_API pose_status pose_get_dynamics_stats(const pose_state *state, pose_dynamics_stats *out);
+
+/**
+ * Couplings (Otaduy et al. §4.2, §5.2): a soft simulation node tied to a
+ * bone by a zero-length spring, as the bone nodes are, where the anatomy
+ * tethers tissue to bone (skin over the shin, the sternum, the skull, the
+ * iliac crest, the olecranon) while the rest slides. The spring's bone end
+ * is `anchor` (model space at rest; pose-bake uses the node's rest
+ * position) moved by the joint's rigid motion (its skinning transform);
+ * its stiffness is `stiffness` times the node's own elastic stiffness at
+ * rest (the trace / 3 of its 3x3 block), as pose_dynamics_options'
+ * coupling_stiffness scales the bone nodes'. POSE_FEM adds the spring to
+ * its equilibrium, pose_step to its forces, stiffness and damping (Rayleigh
+ * beta relative to the bone's motion). Other methods ignore couplings.
+ *
+ * A rig's couplings (its optional `couplings` section: pose-bake resolves
+ * a template's "couplings" to nodes, or pose_rig_desc.fem_couplings) are a
+ * new state's; pose_set_fem_couplings replaces a state's without a rebake.
+ * A node the simulation holds or does not move (a vertex of a bone tet, or
+ * of no soft tet) is already tied to its bone: its coupling is ignored.
+ *
+ * ABI: arrays of pose_fem_coupling are passed with their element size
+ * (sizeof(pose_fem_coupling)); a later version may append fields, read only
+ * when the element size covers them.
+ */
+typedef struct pose_fem_coupling {
+    uint32_t node;     /**< simulation node: tet vertex index (pose_tet_positions) */
+    int joint;         /**< the bone: its joint, 0 <= joint < joint count */
+    float stiffness;   /**< multiple of the node's own elastic stiffness, finite, > 0
+                            (pose-bake's default 100, the bone nodes' default) */
+    float anchor[3];   /**< the spring's bone end at rest, model space, finite */
+} pose_fem_coupling;
+
+/** The rig's couplings: copies min(count, capacity) of them (sorted by node)
+ *  to out (may be NULL with capacity 0) and returns the count (0 without a
+ *  `couplings` section or for a NULL rig). @since 0.2 */
+POSE_API size_t pose_rig_fem_couplings(const pose_rig *rig, pose_fem_coupling *out, size_t capacity);
+/** Simulation nodes (tet vertices of a soft tet and of no bone tet) whose
+ *  rest position lies within `reach` rig units of the rest surface of
+ *  joint's bone tissues (pose_tissue_info: kind POSE_TISSUE_BONE, that
+ *  joint), ascending: min(count, capacity) written to nodes, *count the
+ *  total. POSE_ERR_INVALID_ARGUMENT for a joint out of range or a reach
+ *  not finite or < 0, POSE_ERR_UNSUPPORTED for a rig without a fem section
+ *  or a joint without a bone tissue. Brute force over the bone's triangles
+ *  near each node: for setting up, not per frame. @since 0.2 */
+POSE_API pose_status pose_rig_fem_nodes_near_joint(const pose_rig *rig, int joint, float reach,
+                                                   uint32_t *nodes, size_t capacity, size_t *count);
+/** Replace the state's couplings by `count` entries of `element_size` bytes
+ *  each (>= sizeof(pose_fem_coupling) of 0.2; NULL / 0: none), every node
+ *  < tet vertex count and listed once, joint in range, stiffness finite and
+ *  > 0, anchor finite (else POSE_ERR_INVALID_ARGUMENT, the state's couplings
+ *  unchanged). Allocates with the state's allocator; pose_apply and
+ *  pose_step still allocate nothing. A running simulation keeps its
+ *  velocities (pose_reset_dynamics restarts it). POSE_ERR_UNSUPPORTED for a
+ *  rig without a fem section. @since 0.2 */
+POSE_API pose_status pose_set_fem_couplings(pose_state *state, const pose_fem_coupling *couplings,
+                                            size_t count, size_t element_size);
+/** The state's couplings in effect (the ones on nodes the simulation moves):
+ *  their count. @since 0.2 */
+POSE_API size_t pose_fem_coupling_count(const pose_state *state);
 
 /* ---------------------------------------------------------------- bounds */
 
