@@ -655,8 +655,14 @@ void pose__fem_dyn_step(const pose__fem_mesh *m, pose__fem_work *w, pose__fem_dy
             any |= is->active;
         }
     }
-    const double t2 = now();
+    double t2 = now();
     st.seconds_cg = t2 - t1;
+    if (prm->constrain) {
+        prm->constrain(prm->constrain_ctx);
+        const double t3 = now();
+        st.seconds_constrain = t3 - t2;
+        t2 = t3;
+    }
     run(&c, pool, PASS_INTEGRATE);
     for (size_t k = 0; k < m->chunk_count; k++)
         st.kinetic_energy += w->partial[4 * k];

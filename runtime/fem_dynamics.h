@@ -53,6 +53,10 @@ typedef struct pose__fem_dyn_params {
     float tolerance;      /**< per island: stop at r^T P r <= tolerance^2 max(b^T P b, mm) */
     int cg_iterations;    /**< most CG iterations per island and step */
     float gravity[3];     /**< rig units / s^2 */
+    /** Called after the CG solve, before x' = x + dt v' (the contact
+     *  response: it may change the simulated vertices' v); NULL: none. */
+    void (*constrain)(void *ctx);
+    void *constrain_ctx;
 } pose__fem_dyn_params;
 
 typedef struct pose__fem_dyn_stats {
@@ -61,6 +65,7 @@ typedef struct pose__fem_dyn_stats {
     double kinetic_energy;      /**< 1/2 v'^T M v' after the step */
     double seconds_assembly;    /**< rotations, forces, right-hand side, preconditioner */
     double seconds_cg;          /**< CG iterations */
+    double seconds_constrain;   /**< params.constrain */
 } pose__fem_dyn_stats;
 
 /** Sums a vertex pass forms per segment. */

@@ -21,8 +21,13 @@
  * bandwidth measured in the same run with the same thread count
  * (bound = triad / bytes per step; ratio = achieved / bound).
  *
+ * --contact N: N rounds of the dynamics without and with the contact
+ * response (pose/contact.h: soft nodes kept out of bone by velocity
+ * constraints in the step, the skin pushed out of bone after it),
+ * alternately, and the ratio of their wall times per step.
+ *
  *   fem RIG [--threads N] [--reps N] [--tolerance T] [--outer N] [--steps N]
- *           [--dynamics-only]
+ *           [--dynamics-only] [--contact N]
  */
 #include <math.h>
 #include <stdio.h>
@@ -31,6 +36,7 @@
 
 #include "bench_common.h"
 #include "fem_volume.h"
+#include "pose/contact.h"
 #include "pose/pose.h"
 #include "state_internal.h"
 
@@ -77,12 +83,16 @@ static int set_swing(const pose_rig *rig, pose_state *st, double deg)
     return 0;
 }
 
-static int bench_dynamics(const pose_rig *rig, int threads, int steps)
+/* The dynamics bench; with `contact` the contact response is on (pose/contact.h:
+ * soft nodes kept out of bone in the step, the skin pushed out after it).
+ * The wall time per step into *ms_step when given. */
+static int bench_dynamics(const pose_rig *rig, int threads, int steps, int contact, double *ms_step)
 {
     pose_state_options so = {.size = sizeof so, .threads = threads};
     pose_state *st;
+    pose_contact_response cr = {.size = sizeof cr, .enabled = contact};
     if (pose_state_create_ex(rig, &so, &st) || pose_set_method(st, POSE_FEM) ||
-        pose_set_dynamics_options(st, NULL)) {
+        pose_set_dynamics_options(st, NULL) || pose_set_contact_response(st, &cr)) {
         fprintf(stderr, "fem: %s\n", pose_last_error());
         return -1;
     }
@@ -93,7 +103,7 @@ static int bench_dynamics(const pose_rig *rig, int threads, int steps)
         return -1;
     }
     pose_dynamics_stats ds = {.size = sizeof ds}, sum = {0};
-    double wall = 0.0, cpu = 0.0, peak = 0.0;
+    double wall = 0.0, cpu = 0.0, peak = 0.0, skin_push = 0.0;
     int cg_max = 0;
     for (int s = 1; s <= steps; s++) {
         const double t = s * dt, u = fmod(fmin(t, swing) * rate, 180.0);
@@ -111,6 +121,11 @@ static int bench_dynamics(const pose_rig *rig, int threads, int steps)
         sum.seconds_assembly += ds.seconds_assembly;
         sum.seconds_cg += ds.seconds_cg;
         sum.seconds_transfer += ds.seconds_transfer;
+        sum.seconds_contact += ds.seconds_contact;
+        pose_contact_response_stats cs = {.size = sizeof cs};
+        if (contact && pose_get_contact_response_stats(st, &cs) == POSE_OK)
+            skin_push += cs.seconds;
+        sum.contacts += ds.contacts;
         sum.cg_iterations += ds.cg_iterations;
         cg_max = ds.cg_iterations > cg_max ? ds.cg_iterations : cg_max;
         peak = fmax(peak, ds.kinetic_energy);
@@ -124,9 +139,9 @@ static int bench_dynamics(const pose_rig *rig, int threads, int steps)
     size_t soft = 0;
     for (size_t t = 0; t < tet.tet_count; t++)
         soft += tet.labels[t] == 0;
-    printf("dynamics: dt 1/120 s, %d steps (%.2f s swinging shoulders and elbows 0-90-0 at 360 "
+    printf("dynamics%s: dt 1/120 s, %d steps (%.2f s swinging shoulders and elbows 0-90-0 at 360 "
            "deg/s twice, then rest), %zu tets (%zu soft), %d island(s), %d threads\n",
-           steps, swing, tet.tet_count, soft, ds.islands, threads);
+           contact ? " with contact" : "", steps, swing, tet.tet_count, soft, ds.islands, threads);
     printf("  %.1f steps/s (target 120), %.2f ms/step wall, %.2f ms CPU/step (all threads)\n", sps,
            wall * ms, cpu * ms);
     printf("  per step: skin %.2f ms, assembly %.2f ms, CG %.2f ms (%.1f iterations, most %d, "
@@ -134,6 +149,13 @@ static int bench_dynamics(const pose_rig *rig, int threads, int steps)
            sum.seconds_skin * ms, sum.seconds_assembly * ms, sum.seconds_cg * ms, cg_mean, cg_max,
            sum.cg_iterations ? 1e3 * sum.seconds_cg / sum.cg_iterations : 0.0,
            sum.seconds_transfer * ms);
+    if (contact)
+        printf("  contact: %.2f ms/step (timers): nodes' constraints %.2f, the skin's push %.2f; %.1f "
+               "constraints per step\n",
+               sum.seconds_contact * ms, (sum.seconds_contact - skin_push) * ms, skin_push * ms,
+               (double)sum.contacts / steps);
+    if (ms_step)
+        *ms_step = wall * ms;
     printf("  memory: %.2f MB/step, triad %.2f GB/s -> bound %.0f steps/s; achieved/bound %.3f\n",
            bytes / 1e6, triad / 1e9, bound, sps / bound);
     printf("  kinetic energy: peak %.3e J, %.3e J at the end (%.2f s simulated)\n", peak,
@@ -146,10 +168,10 @@ int main(int argc, char **argv)
 {
     if (argc < 2 || !strcmp(argv[1], "--help")) {
         fprintf(stderr, "usage: fem RIG [--threads N] [--reps N] [--tolerance T] [--outer N] "
-                        "[--steps N] [--dynamics-only]\n");
+                        "[--steps N] [--dynamics-only] [--contact ROUNDS]\n");
         return argc < 2 ? 2 : 0;
     }
-    int threads = 2, reps = 5, outer = 0, steps = 480, statics = 1;
+    int threads = 2, reps = 5, outer = 0, steps = 480, statics = 1, contact = 0;
     float tol = 0.0f;
     for (int i = 2; i < argc; i += 2) {
         if (!strcmp(argv[i], "--dynamics-only")) {
@@ -171,6 +193,8 @@ int main(int argc, char **argv)
             tol = (float)atof(argv[i + 1]);
         else if (!strcmp(argv[i], "--outer"))
             outer = atoi(argv[i + 1]);
+        else if (!strcmp(argv[i], "--contact"))
+            contact = atoi(argv[i + 1]);
         else {
             fprintf(stderr, "fem: unknown option %s\n", argv[i]);
             return 2;
@@ -263,8 +287,24 @@ int main(int argc, char **argv)
     if (statics)
         printf("FEM: largest |dV| %.3f %% (target 0.3 %%), slowest posture (warm) %.2f ms (target "
                "50 ms); process CPU %.1f s\n", 100 * worst, slowest, bench_cpu_seconds());
-    if (steps > 0 && bench_dynamics(rig, threads, steps))
+    if (steps > 0 && !contact && bench_dynamics(rig, threads, steps, 0, NULL))
         return 1;
+    /* --contact N: N rounds of the dynamics without and with the contact
+     * response, alternately (the machine's load drifts), and the ratio of
+     * their wall times per step, each round and over all. */
+    double off_sum = 0.0, on_sum = 0.0;
+    for (int r = 0; steps > 0 && r < contact; r++) {
+        double off = 0.0, on = 0.0;
+        if (bench_dynamics(rig, threads, steps, 0, &off) || bench_dynamics(rig, threads, steps, 1, &on))
+            return 1;
+        off_sum += off;
+        on_sum += on;
+        printf("contact round %d: %.2f ms/step without, %.2f with: ratio %.3f (target <= 1.30)\n", r + 1,
+               off, on, on / off);
+    }
+    if (contact > 0)
+        printf("contact: %d rounds, %.2f ms/step without, %.2f with: ratio %.3f (target <= 1.30)\n", contact,
+               off_sum / contact, on_sum / contact, on_sum / off_sum);
     pose_rig_free(rig);
     return 0;
 }

@@ -64,41 +64,78 @@ static inline uint8_t grid_code(const pose__push_bone *b, const float *q)
     return b->grid[64 * brick + (size_t)((i[2] & 3) << 4 | (i[1] & 3) << 2 | (i[0] & 3))];
 }
 
-/* Push x (posed) out of bone b (frame f) to the margin; the move's length,
- * or 0 when x is farther than the margin outside. */
-static float push_vertex(const pose__push *p, const pose__push_bone *b, const float *f, float *x)
+/* Point q is outside bone j by d or more: into the cache's slot of bone j,
+ * else into slot 0, slot 0 moving to slot 1. */
+static void remember(pose__push_cache *cache, const float *q, float d, uint32_t j)
+{
+    int k = 0;
+    if (cache->slot[1].bone == j)
+        k = 1;
+    else if (cache->slot[0].bone != j)
+        cache->slot[1] = cache->slot[0];
+    cache->slot[k].q[0] = q[0];
+    cache->slot[k].q[1] = q[1];
+    cache->slot[k].q[2] = q[2];
+    cache->slot[k].d = d;
+    cache->slot[k].bone = j;
+}
+
+int pose__push_query(const pose__push *p, const pose__push_bone *b, const float *f, const float *x,
+                     pose__push_cache *cache, float *signed_distance, float *closest, float *outward)
 {
     float q[3];
     to_rest(f, x, q);
+    const uint32_t j = (uint32_t)(b - p->bones);
+    for (int k = 0; cache && k < 2; k++)
+        if (cache->slot[k].bone == j) {
+            /* outside by d at the slot's q (the bone's rest frame): a point
+             * nearer to it than d - margin is outside by more than the
+             * margin (the distance is 1-Lipschitz, and the way there
+             * crosses no surface) */
+            const float dx = q[0] - cache->slot[k].q[0], dy = q[1] - cache->slot[k].q[1],
+                        dz = q[2] - cache->slot[k].q[2], room = cache->slot[k].d - p->margin;
+            if (dx * dx + dy * dy + dz * dz < room * room)
+                return 0;
+        }
     if (!in_box(b, q, 0.0f))
-        return 0.0f;
+        return 0;
     const uint8_t code = grid_code(b, q);
     if (code >= POSE__CELL_OUT)
-        return 0.0f;
+        return 0;
     /* A point of a NEAR_OUT cell is outside: only a triangle within the
-     * margin matters. One of a SURF or NEAR cell has a triangle within
-     * sqrt(3) (cell + margin) (contact_push_build.c), so the search within
-     * that reach finds the nearest (a hit within a shorter reach is the
-     * nearest). Nothing there (rounding): outside, it is farther than the
-     * margin and stays; inside (a ray says so), it searches on, as one of
-     * an IN cell does. */
+     * margin matters (with a cache, the search goes as far as for a NEAR
+     * cell, so that the distance found lets later queries skip). One of a
+     * SURF or NEAR cell has a triangle within sqrt(3) (cell + margin)
+     * (contact_push_build.c), so the search within that reach finds the
+     * nearest (a hit within a shorter reach is the nearest). Nothing there
+     * (rounding): outside, it is farther than the margin and stays; inside
+     * (a ray says so), it searches on, as one of an IN cell does. */
     const float near = code == POSE__CELL_SURF ? 1.7320508f * b->cell * 1.003f /* crossed: within its diagonal */
                                                : 1.7320508f * (b->cell + p->margin) * 1.001f;
     float c[3], out[3];
     float sd = pose__push_distance(b, q,
-                                   code == POSE__CELL_NEAR_OUT ? p->margin
-                                   : code == POSE__CELL_IN     ? INFINITY
-                                                               : near,
+                                   code == POSE__CELL_NEAR_OUT && !cache ? p->margin
+                                   : code == POSE__CELL_IN               ? INFINITY
+                                                                         : near,
                                    c, out);
-    if (isinf(sd) && code == POSE__CELL_NEAR_OUT)
-        return 0.0f;
+    if (code == POSE__CELL_NEAR_OUT && !(fabsf(sd) < p->margin)) { /* nothing within the margin */
+        if (cache)
+            remember(cache, q, isinf(sd) ? near : fabsf(sd), j);
+        return 0;
+    }
     if (isinf(sd)) {
-        if (pose__bvh_winding_along(&b->tree, b->rest, q, f) <= 0)
-            return 0.0f;
+        if (pose__bvh_winding_along(&b->tree, b->rest, q, f) <= 0) {
+            if (cache && code != POSE__CELL_IN)
+                remember(cache, q, near, j);
+            return 0;
+        }
         sd = pose__push_distance(b, q, INFINITY, c, out);
     }
-    if (!(sd < p->margin))
-        return 0.0f;
+    if (!(sd < p->margin)) {
+        if (cache)
+            remember(cache, q, sd, j);
+        return 0;
+    }
     /* Inside by the pseudo-normal is confirmed by the winding number (rays
      * along the model's +x and -x, as pose_contact_detect casts them): on an open
      * or self-overlapping bone mesh the two can disagree, and a push out of
@@ -106,8 +143,22 @@ static float push_vertex(const pose__push *p, const pose__push_bone *b, const fl
     const float minus_x[3] = {-f[0], -f[1], -f[2]};
     if (sd < 0.0f && (pose__bvh_winding_along(&b->tree, b->rest, q, f) <= 0 ||
                       pose__bvh_winding_along(&b->tree, b->rest, q, minus_x) <= 0))
+        return 0;
+    *signed_distance = sd;
+    memcpy(closest, c, sizeof c);
+    memcpy(outward, out, sizeof out);
+    return 1;
+}
+
+/* Push x (posed) out of bone b (frame f) to the margin; the move's length,
+ * or 0 when x is farther than the margin outside. */
+static float push_vertex(const pose__push *p, const pose__push_bone *b, const float *f, float *x,
+                         pose__push_cache *cache)
+{
+    float sd, c[3], out[3];
+    if (!pose__push_query(p, b, f, x, cache, &sd, c, out))
         return 0.0f;
-    float y[3], moved = 0.0f;
+    float q[3], y[3], moved = 0.0f;
     for (int k = 0; k < 3; k++)
         q[k] = c[k] + p->margin * out[k];
     for (int r = 0; r < 3; r++) {
@@ -118,14 +169,14 @@ static float push_vertex(const pose__push *p, const pose__push_bone *b, const fl
     return sqrtf(moved);
 }
 
-/* Bounding sphere (the box's centre and half diagonal) of skin entries
- * [vb, ve). */
-static void sphere_of(const pose_state *st, const uint32_t *order, size_t vb, size_t ve, float *sphere)
+/* Bounding sphere (the box's centre and half diagonal) of points
+ * pos[3 idx[i]] (pos[3 i] when idx is NULL), i in [vb, ve). */
+void pose__push_sphere(const float *pos, const uint32_t *idx, size_t vb, size_t ve, float *sphere)
 {
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t i = vb; i < ve; i++)
         for (int d = 0; d < 3; d++) {
-            const float x = st->tissue_positions[3 * (size_t)order[i] + (size_t)d];
+            const float x = pos[3 * (size_t)(idx ? idx[i] : i) + (size_t)d];
             lo[d] = x < lo[d] ? x : lo[d];
             hi[d] = x > hi[d] ? x : hi[d];
         }
@@ -139,7 +190,7 @@ static void sphere_of(const pose_state *st, const uint32_t *order, size_t vb, si
  * the grid's box, and not all in OUT cells (its centre's cell more than
  * radius + a cell from any non-OUT one: the gap, or its brick's least,
  * which reads a smaller map, when not `fine`). */
-static int sphere_near_bone(const pose__push_bone *b, const float *f, const float *sphere, int fine)
+int pose__push_sphere_near(const pose__push_bone *b, const float *f, const float *sphere, int fine)
 {
     float q[3];
     to_rest(f, sphere, q);
@@ -170,11 +221,11 @@ void pose__state_push_item(void *ctx, size_t item)
         const size_t vb = c * POSE__PUSH_CLUSTER,
                      ve = vb + POSE__PUSH_CLUSTER < p->vertex_count ? vb + POSE__PUSH_CLUSTER : p->vertex_count;
         float cluster[4], group[GROUPS][4];
-        sphere_of(st, p->order, vb, ve, cluster);
+        pose__push_sphere(st->tissue_positions, p->order, vb, ve, cluster);
         const size_t groups = (ve - vb + POSE__PUSH_GROUP - 1) / POSE__PUSH_GROUP;
         for (size_t g = 0; g < groups; g++) {
             const size_t gb = vb + g * POSE__PUSH_GROUP;
-            sphere_of(st, p->order, gb, gb + POSE__PUSH_GROUP < ve ? gb + POSE__PUSH_GROUP : ve, group[g]);
+            pose__push_sphere(st->tissue_positions, p->order, gb, gb + POSE__PUSH_GROUP < ve ? gb + POSE__PUSH_GROUP : ve, group[g]);
         }
         /* One push per vertex per frame: a vertex pushed out of one bone into
          * another stays there rather than move by more than its depth. (A
@@ -185,16 +236,16 @@ void pose__state_push_item(void *ctx, size_t item)
             const float *s = p->bone_spheres + 4 * j, *f = p->frames + 12 * j;
             const float dx = cluster[0] - s[0], dy = cluster[1] - s[1], dz = cluster[2] - s[2];
             const float reach = cluster[3] + s[3] + p->margin;
-            if (dx * dx + dy * dy + dz * dz > reach * reach || !sphere_near_bone(b, f, cluster, 0))
+            if (dx * dx + dy * dy + dz * dz > reach * reach || !pose__push_sphere_near(b, f, cluster, 0))
                 continue;
             for (size_t g = 0; g < groups; g++) {
-                if (!sphere_near_bone(b, f, group[g], 1))
+                if (!pose__push_sphere_near(b, f, group[g], 1))
                     continue;
                 const size_t gb = vb + g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < ve ? gb + POSE__PUSH_GROUP : ve;
                 for (size_t i = gb; i < ge; i++) {
-                    if (p->skip[i] || done[i - vb])
+                    if (p->skip[i] || done[i - vb] || p->own_joint[i] == b->joint)
                         continue;
-                    const float m = push_vertex(p, b, f, st->tissue_positions + 3 * (size_t)p->order[i]);
+                    const float m = push_vertex(p, b, f, st->tissue_positions + 3 * (size_t)p->order[i], &p->cache[i]);
                     done[i - vb] = m > 0.0f;
                     pushed += m > 0.0f;
                     most = m > most ? m : most;

@@ -60,6 +60,17 @@ typedef struct pose__push_bone {
                               the clusters' test reads this small map, not the grid */
 } pose__push_bone;
 
+/** What a point's last queries against two bones proved: at q (the
+ *  bone's rest frame) the point was outside it by d or more, so a later
+ *  query nearer to q than d - margin needs no search (pose__push_query). */
+typedef struct pose__push_cache {
+    struct {
+        float q[3];
+        float d;
+        uint32_t bone; /**< index in pose__push.bones; UINT32_MAX: none */
+    } slot[2];
+} pose__push_cache;
+
 typedef struct pose__push {
     pose_allocator allocator;
     float margin;
@@ -67,12 +78,36 @@ typedef struct pose__push {
     size_t bone_count;
     uint32_t *order;        /**< skin vertices (indices into all tissue vertices), cluster by cluster */
     uint8_t *skip;          /**< per entry of order: inside a bone at rest (anatomy: left alone) */
+    pose__push_cache *cache; /**< per entry of order */
+    int32_t *own_joint;     /**< per entry of order: the joint whose bones it rides with rigidly
+                                 (embedded in a bone tet of that joint whose corners are all
+                                 weighted to it alone, at least RIGID_CLEARANCE from its bones
+                                 at rest): they are not searched for it; -1: none */
     size_t vertex_count, cluster_count;
     float *frames;          /**< per bone per frame: rotation (9, row-major) and translation */
     float *bone_spheres;    /**< per bone per frame: posed centre and radius */
     size_t pushed[POSE__PUSH_ITEMS]; /**< per item of the last pass */
     float max_push[POSE__PUSH_ITEMS];
     double build_seconds;
+    /* The dynamic response (contact_dyn.c): the tet mesh's soft nodes,
+     * built by the first pose_step with the response on. */
+    int nodes_built;
+    int step_keeps_skin;    /**< tests and benches: pose_step leaves the skin where the transfer
+                                 put it (0: pushed out of bone as pose_apply does) */
+    uint32_t *nodes;        /**< soft nodes (tet vertices), cluster by cluster (Morton order at rest) */
+    pose__push_cache *node_cache; /**< per node */
+    uint16_t *node_bone;    /**< per entry: the bone (index in bones) it lies within the margin
+                                 of at rest, or UINT16_MAX */
+    float *node_gap;        /**< per entry: its distance to that bone at rest: the constraint's
+                                 target there (the margin against the others) */
+    size_t node_count, node_clusters;
+    float step_dt;          /**< the step's dt, for the items */
+    size_t constraints[POSE__PUSH_ITEMS]; /**< per item of the last step's response */
+    int sweeps[POSE__PUSH_ITEMS];         /**< most projected Gauss-Seidel sweeps of a node */
+    float max_impulse[POSE__PUSH_ITEMS];  /**< largest impulse, N s */
+    float max_move[POSE__PUSH_ITEMS];     /**< longest move by the response, rig units */
+    float max_excess[POSE__PUSH_ITEMS];   /**< largest move beyond the node's depth in bone at
+                                               its predicted position */
 } pose__push;
 
 struct pose_state;
@@ -87,6 +122,30 @@ void pose__push_release(pose__push *push);
  *  here: returns INFINITY); the nearest point and the outward direction. */
 float pose__push_distance(const pose__push_bone *b, const float *q, float max_dist, float *closest,
                           float *outward);
+
+/** Whether the posed point x is within the margin of bone b (frame f:
+ *  rotation, row-major, and translation, as pose__state_push_frames makes
+ *  them) or inside it (inside confirmed by rays along +x and -x): 1 with
+ *  its signed distance, the nearest surface point and the outward
+ *  direction, both in the bone's rest frame; else 0. The one query of the
+ *  kinematic and the dynamic response. cache (the point's own, or NULL)
+ *  skips the search where the last one proves the point outside, and is
+ *  updated where this one does: the same answers, fewer searches. */
+int pose__push_query(const pose__push *p, const pose__push_bone *b, const float *f, const float *x,
+                     pose__push_cache *cache, float *signed_distance, float *closest, float *outward);
+/** Bounding sphere (centre, radius) of the points pos[3 idx[i]] (pos[3 i]
+ *  when idx is NULL), i in [begin, end). */
+void pose__push_sphere(const float *pos, const uint32_t *idx, size_t begin, size_t end, float *sphere);
+/** Whether a posed sphere may hold a point bone b (frame f) needs tested
+ *  (the grid's gap, per brick unless fine). */
+int pose__push_sphere_near(const pose__push_bone *b, const float *f, const float *sphere, int fine);
+/** The dynamic response's nodes (the state's tet mesh's soft nodes), with
+ *  the state's allocator. */
+pose_status pose__push_build_nodes(pose__push *push, const struct pose_state *st);
+/** pose_step's response, between the solve and x' = x + dt v' (the state's
+ *  dyn.v changed where a soft node would end inside or within the margin
+ *  of a bone); the counts into the push's per-item arrays. */
+void pose__state_contact_step(struct pose_state *st, float dt);
 
 /** pose_apply's last pass when the response is on: the bones' frames for
  *  the pose (serial, cheap), then the skin pushed, item by item. */

@@ -379,6 +379,17 @@ static uint64_t spread(uint64_t v) /* 21 bits -> every third bit */
     return v;
 }
 
+/* x's Morton key in the box [lo, hi]. */
+static uint64_t morton_of(const float *x, const float *lo, const float *hi)
+{
+    uint64_t key = 0;
+    for (int d = 0; d < 3; d++) {
+        const float e = hi[d] > lo[d] ? (x[d] - lo[d]) / (hi[d] - lo[d]) : 0.0f;
+        key |= spread((uint64_t)(e * 1048575.0f)) << d;
+    }
+    return key;
+}
+
 /* Skin vertices in Morton order of their rest positions: consecutive runs
  * of POSE__PUSH_CLUSTER are compact clusters. */
 static pose_status skin_order(pose__push *p, const pose_state *st)
@@ -392,8 +403,9 @@ static pose_status skin_order(pose__push *p, const pose_state *st)
     p->cluster_count = (n + POSE__PUSH_CLUSTER - 1) / POSE__PUSH_CLUSTER;
     p->order = pose__alloc(&p->allocator, (n + 1) * sizeof *p->order, POSE__ALIGN);
     p->skip = pose__calloc(&p->allocator, n + 1, POSE__ALIGN);
+    p->cache = pose__alloc(&p->allocator, (n + 1) * sizeof *p->cache, POSE__ALIGN);
     morton_key *k = pose__alloc(&p->allocator, (n + 1) * sizeof *k, POSE__ALIGN);
-    if (!p->order || !p->skip || !k) {
+    if (!p->order || !p->skip || !p->cache || !k) {
         pose__free(&p->allocator, k);
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu skin vertices", n);
     }
@@ -409,18 +421,14 @@ static pose_status skin_order(pose__push *p, const pose_state *st)
         const pose__tissue *ts = &rig->tissues[t];
         if (ts->kind != POSE_TISSUE_SKIN)
             continue;
-        for (size_t v = 0; v < ts->vertex_count; v++, i++) {
-            uint64_t key = 0;
-            for (int d = 0; d < 3; d++) {
-                const float e = hi[d] > lo[d] ? (ts->positions[3 * v + (size_t)d] - lo[d]) / (hi[d] - lo[d]) : 0.0f;
-                key |= spread((uint64_t)(e * 1048575.0f)) << d;
-            }
-            k[i] = (morton_key){key, (uint32_t)(st->rt->tissue_offset[t] + v)};
-        }
+        for (size_t v = 0; v < ts->vertex_count; v++, i++)
+            k[i] = (morton_key){morton_of(ts->positions + 3 * v, lo, hi), (uint32_t)(st->rt->tissue_offset[t] + v)};
     }
     qsort(k, n, sizeof *k, cmp_morton);
-    for (i = 0; i < n; i++)
+    for (i = 0; i < n; i++) {
         p->order[i] = k[i].vertex;
+        p->cache[i].slot[0].bone = p->cache[i].slot[1].bone = UINT32_MAX;
+    }
     pose__free(&p->allocator, k);
     return POSE_OK;
 }
@@ -447,6 +455,58 @@ static void mark_rest_inside(pose__push *p, const pose_state *st)
     }
 }
 
+/* How far from its own bones a skin vertex riding rigidly with them must
+ * be at rest to be left out of their search: the margin and what the
+ * dynamics' bone springs let a bone node lag (0.15 mm measured) with room. */
+#define RIGID_CLEARANCE(margin) ((margin) + 0.001f)
+
+/* Skin embedded in a bone tet whose four corners are weighted to that
+ * tet's joint alone moves with that joint's bones rigidly with every
+ * method (skinning, POSE_FEM's held bone tets, the dynamics' bone nodes on
+ * their springs): its distance to them stays its rest distance, so those
+ * bones are not searched for it (half the coarse body's skin lies in bone
+ * tets: the pass's most frequent exact queries). */
+static pose_status mark_rigid(pose__push *p, const pose_state *st)
+{
+    const pose_rig *rig = st->rig;
+    p->own_joint = pose__alloc(&p->allocator, (p->vertex_count + 1) * sizeof *p->own_joint, POSE__ALIGN);
+    if (!p->own_joint)
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu skin vertices", p->vertex_count);
+    const unsigned K = rig->influences;
+    for (size_t i = 0; i < p->vertex_count; i++) {
+        const uint32_t v = p->order[i];
+        p->own_joint[i] = -1;
+        size_t t = 0;
+        while (st->rt->tissue_offset[t + 1] <= v)
+            t++;
+        const pose__tissue *ts = &rig->tissues[t];
+        const size_t local = v - st->rt->tissue_offset[t];
+        const uint32_t tet = ts->tet[local];
+        if (p->skip[i] || !rig->tet_labels || rig->tet_labels[tet] == 0)
+            continue;
+        const int joint = rig->tet_labels[tet] - 1;
+        int rigid = 1;
+        for (int c = 0; c < 4 && rigid; c++) {
+            const size_t tv = rig->tets[4 * (size_t)tet + (size_t)c];
+            float w = 0.0f;
+            for (unsigned k = 0; k < K; k++)
+                if (rig->weight_joints[K * tv + k] == joint)
+                    w += rig->weights[K * tv + k];
+            rigid = w >= 1.0f - 1e-6f;
+        }
+        const float *x = ts->positions + 3 * local;
+        for (size_t j = 0; j < p->bone_count && rigid; j++) {
+            const pose__push_bone *b = &p->bones[j];
+            float c[3], o[3];
+            if (b->joint == joint)
+                rigid = pose__push_distance(b, x, RIGID_CLEARANCE(p->margin), c, o) == INFINITY;
+        }
+        if (rigid)
+            p->own_joint[i] = joint;
+    }
+    return POSE_OK;
+}
+
 void pose__push_release(pose__push *p)
 {
     const pose_allocator *a = &p->allocator;
@@ -462,8 +522,14 @@ void pose__push_release(pose__push *p)
     pose__free(a, p->bones);
     pose__free(a, p->order);
     pose__free(a, p->skip);
+    pose__free(a, p->cache);
+    pose__free(a, p->own_joint);
     pose__free(a, p->frames);
     pose__free(a, p->bone_spheres);
+    pose__free(a, p->nodes);
+    pose__free(a, p->node_cache);
+    pose__free(a, p->node_bone);
+    pose__free(a, p->node_gap);
     const pose_allocator keep = *a;
     memset(p, 0, sizeof *p);
     p->allocator = keep;
@@ -502,6 +568,75 @@ pose_status pose__push_build(pose__push *p, const pose_state *st, float margin)
     if (s != POSE_OK)
         return s;
     mark_rest_inside(p, st);
+    if ((s = mark_rigid(p, st)) != POSE_OK)
+        return s;
     p->build_seconds = pose__seconds() - t0;
+    return POSE_OK;
+}
+
+/* The bone a rest point lies within the margin of (nearest), and its
+ * distance, into *bone and *gap; 1 when it is inside a bone at rest. */
+static int rest_gap(const pose__push *p, const float *x, uint16_t *bone, float *gap)
+{
+    static const float identity[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    *bone = UINT16_MAX;
+    *gap = INFINITY;
+    for (size_t j = 0; j < p->bone_count && j < UINT16_MAX; j++) {
+        float sd, c[3], o[3];
+        if (!pose__push_query(p, &p->bones[j], identity, x, NULL, &sd, c, o))
+            continue;
+        if (sd < 0.0f)
+            return 1;
+        if (sd < *gap) {
+            *gap = sd;
+            *bone = (uint16_t)j;
+        }
+    }
+    return 0;
+}
+
+/* The dynamic response's nodes: every tet vertex the simulation moves
+ * freely (mass, a soft tet, no bone spring: fem_dynamics.h), in Morton
+ * order of its rest position, but those inside a bone at rest (the tet
+ * mesh's bone region and the bones' meshes differ: anatomy, left alone as
+ * the skin in bone at rest is). A node within the margin of a bone at rest
+ * keeps its rest distance to it as its target there, so rest stays rest. */
+pose_status pose__push_build_nodes(pose__push *p, const pose_state *st)
+{
+    const pose_allocator *a = &p->allocator;
+    const pose__fem_mesh *m = &st->rt->fem;
+    const float *rest = st->rig->tet_positions;
+    const size_t nv = m->vertex_count;
+    p->nodes = pose__alloc(a, (nv + 1) * sizeof *p->nodes, POSE__ALIGN);
+    p->node_bone = pose__alloc(a, (nv + 1) * sizeof *p->node_bone, POSE__ALIGN);
+    p->node_gap = pose__alloc(a, (nv + 1) * sizeof *p->node_gap, POSE__ALIGN);
+    p->node_cache = pose__alloc(a, (nv + 1) * sizeof *p->node_cache, POSE__ALIGN);
+    morton_key *k = pose__alloc(a, (nv + 1) * sizeof *k, POSE__ALIGN);
+    if (!p->nodes || !p->node_bone || !p->node_gap || !p->node_cache || !k) {
+        pose__free(a, k);
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu nodes of the contact response", nv);
+    }
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t v = 0; v < 3 * nv; v++) {
+        lo[v % 3] = fminf(lo[v % 3], rest[v]);
+        hi[v % 3] = fmaxf(hi[v % 3], rest[v]);
+    }
+    size_t n = 0;
+    for (size_t v = 0; v < nv; v++)
+        if (m->corner_offset[v + 1] > m->corner_offset[v] && m->mass[v] > 0.0f && m->inv_diag[v] != 0.0f)
+            k[n++] = (morton_key){morton_of(rest + 3 * v, lo, hi), (uint32_t)v};
+    qsort(k, n, sizeof *k, cmp_morton);
+    size_t kept = 0;
+    for (size_t i = 0; i < n; i++) {
+        const uint32_t v = k[i].vertex;
+        if (rest_gap(p, rest + 3 * (size_t)v, &p->node_bone[kept], &p->node_gap[kept]))
+            continue;
+        p->node_cache[kept].slot[0].bone = p->node_cache[kept].slot[1].bone = UINT32_MAX;
+        p->nodes[kept++] = v;
+    }
+    p->node_count = kept;
+    p->node_clusters = (kept + POSE__PUSH_CLUSTER - 1) / POSE__PUSH_CLUSTER;
+    p->nodes_built = 1;
+    pose__free(a, k);
     return POSE_OK;
 }

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "alloc.h"
+#include "contact_push.h"
 #include "error.h"
 #include "state_internal.h"
 
@@ -128,7 +129,16 @@ pose_status pose_reset_dynamics(pose_state *st)
     if (!fresh)
         restart(st);
     pose__state_transfer_pass(st);
+    pose__state_push(st); /* with the contact response on, as pose_apply */
     return POSE_OK;
+}
+
+/* The contact response between the solve and the integration
+ * (contact_dyn.c). */
+static void constrain(void *ctx)
+{
+    pose_state *st = ctx;
+    pose__state_contact_step(st, st->push->step_dt);
 }
 
 pose_status pose_step(pose_state *st, double dt)
@@ -141,13 +151,20 @@ pose_status pose_step(pose_state *st, double dt)
     pose_status s = enable(st, "pose_step");
     if (s < 0)
         return s;
+    /* With the contact response on, its nodes (the first such step). */
+    pose__push *push = st->push && st->push_enabled ? st->push : NULL;
+    if (push && !push->nodes_built && (s = pose__push_build_nodes(push, st)) < 0)
+        return s;
     const pose_dynamics_options *o = &st->dyn_options;
     pose__fem_dyn_params prm = {
         .dt = (float)dt, .alpha = o->mass_damping, .beta = o->stiffness_damping,
         .coupling = o->coupling_stiffness, .tolerance = o->tolerance,
         .cg_iterations = o->cg_iterations,
         .gravity = {o->gravity[0], o->gravity[1], o->gravity[2]},
+        .constrain = push ? constrain : NULL, .constrain_ctx = st,
     };
+    if (push)
+        push->step_dt = (float)dt;
     pose_dynamics_stats *ds = &st->dyn_stats;
     const double t0 = pose__seconds();
     pose__state_skin_pass(st); /* the bones' positions at the end of the step */
@@ -159,6 +176,9 @@ pose_status pose_step(pose_state *st, double dt)
     memcpy(st->tet_positions, st->dyn.x, 3 * st->rig->tet_vertex_count * sizeof(float));
     const double t2 = pose__seconds();
     pose__state_transfer_pass(st);
+    const double t3 = pose__seconds();
+    if (push && !push->step_keeps_skin)
+        pose__state_push(st); /* the skin out of bone, as pose_apply leaves it (contact_push.c) */
     ds->size = sizeof *ds;
     ds->islands = (int)st->dyn.island_count;
     ds->cg_iterations = fs.cg_iterations;
@@ -168,7 +188,18 @@ pose_status pose_step(pose_state *st, double dt)
     ds->seconds_skin = t1 - t0;
     ds->seconds_assembly = t2 - t1 - fs.seconds_cg; /* with the copy to the outputs */
     ds->seconds_cg = fs.seconds_cg;
-    ds->seconds_transfer = pose__seconds() - t2;
+    ds->seconds_transfer = t3 - t2;
+    ds->contacts = 0;
+    ds->contact_iterations = 0;
+    ds->max_impulse = 0.0;
+    ds->seconds_contact = fs.seconds_constrain + (pose__seconds() - t3);
+    ds->seconds_assembly -= fs.seconds_constrain;
+    for (size_t k = 0; push && k < POSE__PUSH_ITEMS; k++) {
+        ds->contacts += (int)push->constraints[k];
+        ds->contact_iterations =
+            push->sweeps[k] > ds->contact_iterations ? push->sweeps[k] : ds->contact_iterations;
+        ds->max_impulse = fmax(ds->max_impulse, (double)push->max_impulse[k]);
+    }
     return POSE_OK;
 }
 
@@ -178,12 +209,14 @@ pose_status pose_get_dynamics_stats(const pose_state *st, pose_dynamics_stats *o
     if (!st || !out)
         return pose__fail(POSE_ERR_INVALID_ARGUMENT,
                           "pose_get_dynamics_stats: state and out are required");
-    if (out->size < sizeof(pose_dynamics_stats))
+    if (out->size < POSE_DYNAMICS_STATS_SIZE_0_2)
         return pose__fail(POSE_ERR_INVALID_ARGUMENT,
                           "pose_get_dynamics_stats: out->size %zu is below the 0.2 layout (%zu)",
-                          out->size, sizeof(pose_dynamics_stats));
-    *out = st->dyn_stats;
-    out->size = sizeof(pose_dynamics_stats);
+                          out->size, (size_t)POSE_DYNAMICS_STATS_SIZE_0_2);
+    /* a caller built before the contact fields gets the fields it has */
+    const size_t size = out->size < sizeof(pose_dynamics_stats) ? out->size : sizeof(pose_dynamics_stats);
+    memcpy(out, &st->dyn_stats, size);
+    out->size = size;
     return POSE_OK;
 }
 

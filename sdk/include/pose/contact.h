@@ -116,17 +116,47 @@ POSE_API const uint8_t *pose_contact_vertex_flags(const pose_contact *contact, i
  * Cost: the first pose_set_contact_response that enables it (or changes
  * the margin) builds the bones' structures with the state's allocator
  * (pose_contact_response_stats.build_seconds); pose_apply allocates
- * nothing and runs the pass on the state's threads.
+ * nothing and runs the pass on the state's threads. A skin vertex embedded
+ * in a bone tet that moves rigidly with its joint (all four corners
+ * weighted to it alone) and lies farther than the margin plus 1 mm from
+ * that joint's bones at rest is not searched against them: its distance
+ * to them cannot change.
+ *
+ * Dynamics (pose_step, pose.h): with the response on, each step also keeps
+ * the tet mesh's soft nodes (vertices of soft tets only: bone nodes ride
+ * their springs) out of bone, by velocity-level non-penetration
+ * constraints solved after the unconstrained solve (Otaduy et al. §5.3):
+ * a node whose predicted end position x + dt v lies inside a bone or
+ * within the margin of it (the same query as above, on the bone where the
+ * step's skeleton puts it) gets n . (v' - v) >= (margin - s) / dt for that
+ * bone (s its signed distance, n the outward normal; a node nearer than
+ * the margin at rest keeps its rest distance instead), at most four bones
+ * per node; projected Gauss-Seidel solves each node's constraints (bones
+ * are kinematic, so a contact island is one node with its constraints),
+ * the impulse's effective mass from the isotropic part of the node's
+ * diagonal block of the step's system matrix; x' = x + dt v' moves the
+ * node. The correction is whole within the step: a node ends at the
+ * margin, moved by the response by its predicted depth in bone plus the
+ * margin at most, and the step's velocity keeps it (no bounce beyond the
+ * depth). Then, after the transfer, the skin is pushed out of bone as
+ * pose_apply pushes it (the simulation mesh is coarser than the skin:
+ * bone comes through between nodes). Nodes inside a bone at rest are
+ * anatomy, left alone. The first pose_step with the response on finds the
+ * nodes (allocating with the state's allocator); later steps allocate
+ * nothing; the same bits for any thread count. pose_dynamics_stats counts
+ * the constraints, sweeps and largest impulse; the push's figures are in
+ * pose_contact_response_stats.
  */
 
 /** Response settings; a zeroed struct (size set or 0) is off. */
 typedef struct pose_contact_response {
     size_t size;  /**< sizeof(pose_contact_response), or 0 */
-    int enabled;  /**< nonzero: pose_apply pushes skin out of bone */
+    int enabled;  /**< nonzero: pose_apply pushes skin out of bone; pose_step keeps soft
+                       nodes out of bone and pushes the skin */
     float margin; /**< distance kept from bone, rig units; 0 = 0.0005 (0.5 mm in metres) */
 } pose_contact_response;
 
-/** What the last pose_apply's response did. */
+/** What the last pose_apply's (or pose_step's) push of the skin did. */
 typedef struct pose_contact_response_stats {
     size_t size;          /**< sizeof(pose_contact_response_stats), set by the caller */
     size_t pushed;        /**< skin vertices moved */
@@ -136,12 +166,12 @@ typedef struct pose_contact_response_stats {
     double build_seconds; /**< building the bones' structures */
 } pose_contact_response_stats;
 
-/** Turn the response on or off (NULL: off). POSE_ERR_INVALID_ARGUMENT for
- *  a bad size or a negative or non-finite margin; POSE_ERR_OUT_OF_MEMORY
- *  (the response is off then). @since 0.2 */
+/** Turn the response on or off (NULL: off), for pose_apply and pose_step.
+ *  POSE_ERR_INVALID_ARGUMENT for a bad size or a negative or non-finite
+ *  margin; POSE_ERR_OUT_OF_MEMORY (the response is off then). @since 0.2 */
 POSE_API pose_status pose_set_contact_response(pose_state *state, const pose_contact_response *settings);
 
-/** Statistics of the last pose_apply's response (zeros with it off);
+/** Statistics of the last pose_apply's or pose_step's push (zeros with it off);
  *  out->size must be set. @since 0.2 */
 POSE_API pose_status pose_get_contact_response_stats(const pose_state *state,
                                                      pose_contact_response_stats *out);

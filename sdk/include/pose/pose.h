@@ -673,6 +673,9 @@ POSE_API pose_status pose_get_fem_stats(const pose_state *state, pose_fem_stats 
  * pose_apply writes the outputs from skinning (or POSE_FEM) and leaves the
  * simulation as it is; the last of the two calls is what the outputs show.
  * Stable from dt = 1/1000 s to 1/30 s, also under fast joint swings.
+ * Contact: with pose_set_contact_response on (pose/contact.h), each step
+ * keeps the soft nodes out of bone by velocity constraints solved after
+ * the CG solve, and pushes the skin out of bone after the transfer.
  */
 
 /** Dynamics settings. Start from pose_dynamics_defaults; every field is
@@ -704,7 +707,18 @@ typedef struct pose_dynamics_stats {
     double seconds_assembly;  /**< rotations, forces, right-hand side, preconditioner, update */
     double seconds_cg;        /**< conjugate gradient iterations */
     double seconds_transfer;  /**< transfer to the tissues */
+    /* The contact response in pose_step (pose_set_contact_response on;
+     * pose/contact.h), zeros with it off. Appended in 0.2: a caller whose
+     * size ends before them gets the fields above. */
+    int contacts;             /**< velocity constraints (a soft node against a bone) */
+    int contact_iterations;   /**< most projected Gauss-Seidel sweeps of a contact island */
+    double max_impulse;       /**< largest constraint impulse, N s (rig units: kg m/s) */
+    double seconds_contact;   /**< detection and response (not in seconds_assembly) */
 } pose_dynamics_stats;
+
+/** Size of pose_dynamics_stats before the contact fields: the least size
+ *  pose_get_dynamics_stats accepts. */
+#define POSE_DYNAMICS_STATS_SIZE_0_2 (offsetof(pose_dynamics_stats, seconds_transfer) + sizeof(double))
 
 /** The default dynamics settings (size set). @since 0.2 */
 POSE_API void pose_dynamics_defaults(pose_dynamics_options *out);
@@ -720,7 +734,9 @@ POSE_API pose_status pose_step(pose_state *state, double dt);
 /** Restart the simulation at rest in the current skinned pose and write
  *  the outputs. Errors as pose_set_dynamics_options. @since 0.2 */
 POSE_API pose_status pose_reset_dynamics(pose_state *state);
-/** Statistics of the last pose_step (zeros before one); out->size must be set. @since 0.2 */
+/** Statistics of the last pose_step (zeros before one); out->size must be
+ *  set, at least POSE_DYNAMICS_STATS_SIZE_0_2 (the fields it covers are
+ *  written). @since 0.2 */
 POSE_API pose_status pose_get_dynamics_stats(const pose_state *state, pose_dynamics_stats *out);
 
 /**
