@@ -301,10 +301,27 @@ static void knees_and_elbows(void **unused)
     free(one.ramp_tets);
 }
 
-int main(void)
+/* The ramp with the response on, 1 and 2 threads: the same bits (the
+ * TSan stage runs this alone: contact_dynamics_threads). */
+static void threads(void **unused)
+{
+    (void)unused;
+    run_result two = run(2, 1, 0), one = run(1, 1, 0);
+    assert_true(two.contacts_max > 0);
+    assert_memory_equal(two.ramp_tets, one.ramp_tets, 3 * g.tet.vertex_count * sizeof(float));
+    free(two.ramp_tets);
+    free(one.ramp_tets);
+}
+
+int main(int argc, char **argv)
 {
     const struct CMUnitTest all[] = {
         cmocka_unit_test(knees_and_elbows),
     };
+    const struct CMUnitTest only_threads[] = {
+        cmocka_unit_test(threads),
+    };
+    if (argc > 1 && !strcmp(argv[1], "threads"))
+        return cmocka_run_group_tests(only_threads, setup, teardown);
     return cmocka_run_group_tests(all, setup, teardown);
 }
