@@ -151,9 +151,11 @@ static int bench_dynamics(const pose_rig *rig, int threads, int steps, int conta
            sum.seconds_transfer * ms);
     if (contact)
         printf("  contact: %.2f ms/step (timers): nodes' constraints %.2f, the skin's push %.2f; %.1f "
-               "constraints per step\n",
+               "constraints per step; %.1f %% of the rest of the step's timers\n",
                sum.seconds_contact * ms, (sum.seconds_contact - skin_push) * ms, skin_push * ms,
-               (double)sum.contacts / steps);
+               (double)sum.contacts / steps,
+               100.0 * sum.seconds_contact /
+                   (sum.seconds_skin + sum.seconds_assembly + sum.seconds_cg + sum.seconds_transfer));
     if (ms_step)
         *ms_step = wall * ms;
     printf("  memory: %.2f MB/step, triad %.2f GB/s -> bound %.0f steps/s; achieved/bound %.3f\n",

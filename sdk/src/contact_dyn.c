@@ -135,7 +135,7 @@ static void contact_item(void *ctx, size_t item)
             if (dx * dx + dy * dy + dz * dz > reach * reach || !pose__push_sphere_near(b, f, cluster, 0))
                 continue;
             for (size_t g = 0; g < groups; g++) {
-                if (!pose__push_sphere_near(b, f, group[g], 1))
+                if (!pose__push_sphere_near(b, f, group[g], 0))
                     continue;
                 const size_t gb = g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < count ? gb + POSE__PUSH_GROUP : count;
                 for (size_t i = gb; i < ge; i++) {

@@ -97,11 +97,26 @@ int pose__push_query(const pose__push *p, const pose__push_bone *b, const float 
             if (dx * dx + dy * dy + dz * dz < room * room)
                 return 0;
         }
-    if (!in_box(b, q, 0.0f))
+    if (!in_box(b, q, 0.0f)) {
+        if (cache) { /* outside the box, which is the bone's grown by a cell and the margin */
+            float e2 = 0.0f;
+            for (int d = 0; d < 3; d++) {
+                const float e = q[d] < b->lo[d] ? b->lo[d] - q[d] : q[d] > b->hi[d] ? q[d] - b->hi[d] : 0.0f;
+                e2 += e * e;
+            }
+            const float d = sqrtf(e2) + b->cell + p->margin;
+            remember(cache, q, d, j);
+        }
         return 0;
+    }
     const uint8_t code = grid_code(b, q);
-    if (code >= POSE__CELL_OUT)
+    if (code >= POSE__CELL_OUT) {
+        /* every cell that is not OUT lies (gap - 1) cells or more away,
+         * and the surface and its margin are in those */
+        if (cache && code > POSE__CELL_OUT)
+            remember(cache, q, (float)(code - POSE__CELL_OUT) * b->cell + p->margin, j);
         return 0;
+    }
     /* A point of a NEAR_OUT cell is outside: only a triangle within the
      * margin matters (with a cache, the search goes as far as for a NEAR
      * cell, so that the distance found lets later queries skip). One of a
@@ -198,9 +213,17 @@ int pose__push_sphere_near(const pose__push_bone *b, const float *f, const float
         return 0;
     int i[3];
     const size_t brick = brick_of(b, q, i);
+    /* the brick's least gap first (a small map, mostly in cache): a cell's
+     * gap is at least its brick's, so what the brick rejects the cell does */
+    const float reach = sphere[3] * 1.001f + 1e-6f;
+    const int least = b->brick_gap[brick];
+    if (least > 1 && ((float)least - 1.0f) * b->cell > reach)
+        return 0;
+    if (!fine)
+        return 1;
     const uint8_t code = b->grid[64 * brick + (size_t)((i[2] & 3) << 4 | (i[1] & 3) << 2 | (i[0] & 3))];
-    const int gap = fine ? (code >= POSE__CELL_OUT ? code - (POSE__CELL_OUT - 1) : 0) : b->brick_gap[brick];
-    return !(gap > 1 && ((float)gap - 1.0f) * b->cell > sphere[3] * 1.001f + 1e-6f);
+    const int gap = code >= POSE__CELL_OUT ? code - (POSE__CELL_OUT - 1) : 0;
+    return !(gap > 1 && ((float)gap - 1.0f) * b->cell > reach);
 }
 
 /* Clusters split into items: each vertex is moved by one item, bone after
@@ -239,7 +262,7 @@ void pose__state_push_item(void *ctx, size_t item)
             if (dx * dx + dy * dy + dz * dz > reach * reach || !pose__push_sphere_near(b, f, cluster, 0))
                 continue;
             for (size_t g = 0; g < groups; g++) {
-                if (!pose__push_sphere_near(b, f, group[g], 1))
+                if (!pose__push_sphere_near(b, f, group[g], 0))
                     continue;
                 const size_t gb = vb + g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < ve ? gb + POSE__PUSH_GROUP : ve;
                 for (size_t i = gb; i < ge; i++) {
