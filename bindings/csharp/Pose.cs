@@ -70,6 +70,8 @@ namespace Pose
         public int Islands, CgIterations;
         public double Residual, KineticEnergy, Time;
         public double SecondsSkin, SecondsAssembly, SecondsCg, SecondsTransfer;
+        public int Contacts, ContactIterations; // the contact response in pose_step (pose/contact.h)
+        public double MaxImpulse, SecondsContact;
     }
 
     [StructLayout(LayoutKind.Sequential)]

@@ -10,7 +10,8 @@
  * must agree, as pose_contact_detect counts skin). No node moves by the
  * response more than its depth in bone plus 1 mm (the pass's own measure,
  * per step); the kinetic energy decays after the stop; 1 and 2 threads
- * give the same bits. A rig path is taken from POSE_CONTACT_RIG. */
+ * give the same bits; pose_get_dynamics_stats with the size before the
+ * contact fields. A rig path is taken from POSE_CONTACT_RIG. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -211,6 +212,19 @@ static run_result run(int threads, int contact, int hold)
         assert_int_equal(pose_step(st, DT), POSE_OK);
         pose_dynamics_stats ds = {.size = sizeof ds};
         assert_int_equal(pose_get_dynamics_stats(st, &ds), POSE_OK);
+        if (k == 1) { /* a caller built before the contact fields: they stay untouched */
+            pose_dynamics_stats old;
+            memset(&old, 0x5a, sizeof old);
+            old.size = POSE_DYNAMICS_STATS_SIZE_0_2;
+            assert_int_equal(pose_get_dynamics_stats(st, &old), POSE_OK);
+            assert_int_equal(old.size, POSE_DYNAMICS_STATS_SIZE_0_2);
+            assert_true(old.time == ds.time && old.kinetic_energy == ds.kinetic_energy);
+            const unsigned char *tail = (const unsigned char *)&old + POSE_DYNAMICS_STATS_SIZE_0_2;
+            for (size_t b = 0; b < sizeof old - POSE_DYNAMICS_STATS_SIZE_0_2; b++)
+                assert_int_equal(tail[b], 0x5a);
+            old.size = POSE_DYNAMICS_STATS_SIZE_0_2 - 1;
+            assert_int_equal(pose_get_dynamics_stats(st, &old), POSE_ERR_INVALID_ARGUMENT);
+        }
         assert_true(isfinite(ds.kinetic_energy));
         r.peak = fmax(r.peak, ds.kinetic_energy);
         if (k == RAMP_STEPS + hold / 2)

@@ -90,4 +90,6 @@ class DynamicsStats(ctypes.Structure):
     _fields_ = [("size", ctypes.c_size_t), ("islands", ctypes.c_int), ("cg_iterations", ctypes.c_int),
                 ("residual", ctypes.c_double), ("kinetic_energy", ctypes.c_double), ("time", ctypes.c_double),
                 ("seconds_skin", ctypes.c_double), ("seconds_assembly", ctypes.c_double),
-                ("seconds_cg", ctypes.c_double), ("seconds_transfer", ctypes.c_double)]
+                ("seconds_cg", ctypes.c_double), ("seconds_transfer", ctypes.c_double),
+                ("contacts", ctypes.c_int), ("contact_iterations", ctypes.c_int),
+                ("max_impulse", ctypes.c_double), ("seconds_contact", ctypes.c_double)]
