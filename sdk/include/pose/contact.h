@@ -137,8 +137,9 @@ POSE_API const uint8_t *pose_contact_vertex_flags(const pose_contact *contact, i
  * diagonal block of the step's system matrix; x' = x + dt v' moves the
  * node. The correction is whole within the step: a node ends at the
  * margin, moved by the response by its predicted depth in bone plus the
- * margin at most, and the step's velocity keeps it (no bounce beyond the
- * depth). Then, after the transfer, the skin is pushed out of bone as
+ * margin at most, and the velocity change stays in v' (the next step
+ * starts from it; a node that was not inside at the start of the step
+ * leaves with its bone's normal velocity, no bounce). Then, after the transfer, the skin is pushed out of bone as
  * pose_apply pushes it (the simulation mesh is coarser than the skin:
  * bone comes through between nodes). Nodes inside a bone at rest are
  * anatomy, left alone. The first pose_step with the response on finds the
