@@ -34,17 +34,29 @@ void pose__fem_dyn_tets_build(const pose__fem_mesh *m, pose__fem_dyn_tets *tets,
     pose__fem_dyn_rot_reset(m, rot);
 }
 
+void pose__fem_dyn_set_skeletal(pose__fem_dyn_tets *tets, size_t t, int n, const uint32_t *joints,
+                                const float *weights)
+{
+    pose__fem_dyn_tets *d = &tets[t / POSE__FEM_LANES];
+    const size_t l = t % POSE__FEM_LANES;
+    d->skeletal[l] = n > 0 ? UINT32_MAX : 0u;
+    for (int i = 0; i < 4; i++) {
+        d->joint[i][l] = i < n ? joints[i] : (n > 0 ? joints[0] : 0u);
+        d->weight[i][l] = i < n ? weights[i] : 0.0f;
+    }
+}
+
 void pose__fem_dyn_rotate(const pose__fem_dyn_tets *tets, pose__fem_dyn_rot *rot, const float *x,
-                          const float *v, int steps, float twist, float *f, float *kv, float *blk,
-                          uint32_t *flag, size_t b, size_t e)
+                          const float *joint_q, const float *v, int steps, float twist, float *f,
+                          float *kv, float *blk, uint32_t *flag, size_t b, size_t e)
 {
 #ifdef POSE__HAVE_AVX2_KERNELS
     if (pose__kernels_use_avx2()) {
-        pose__fem_dyn_rotate_avx2(tets, rot, x, v, steps, twist, f, kv, blk, flag, b, e);
+        pose__fem_dyn_rotate_avx2(tets, rot, x, joint_q, v, steps, twist, f, kv, blk, flag, b, e);
         return;
     }
 #endif
-    pose__fem_dyn_rotate_generic(tets, rot, x, v, steps, twist, f, kv, blk, flag, b, e);
+    pose__fem_dyn_rotate_generic(tets, rot, x, joint_q, v, steps, twist, f, kv, blk, flag, b, e);
 }
 
 void pose__fem_dyn_product(const pose__fem_dyn_tets *tets, const pose__fem_dyn_rot *rot,

@@ -33,13 +33,20 @@
 
 #define POSE__FEM_LANES 8u
 
-/** Eight tets' constants: 480 bytes (a multiple of 32: blocks stay aligned). */
+/** Eight tets' constants: 768 bytes (a multiple of 32: blocks stay aligned). */
 typedef struct pose__fem_dyn_tets {
     uint32_t v[4][8];   /**< vertex of corner k, per lane */
     float b[9][8];      /**< pose__fem_tet.b, per lane */
     float vmu[8];       /**< rest volume * mu */
     float vlambda[8];   /**< rest volume * lambda (= kappa - 2 mu / 3) */
+    uint32_t skeletal[8];   /**< all bits set: the tet turns with the skeleton, else 0 */
+    uint32_t joint[4][8];   /**< a skeletal tet's joints (pose__fem_dyn_set_skeletal) */
+    float weight[4][8];     /**< and their weights (summing to 1; 0 for unused) */
 } pose__fem_dyn_tets;
+
+/** Floats from one joint's rotation to the next in pose__fem_dyn_rotate's
+ *  joint_q (the skinning palette, rt_skin.h's pose__skin_joint). */
+#define POSE__FEM_JOINT_STRIDE 16u
 
 /** Eight tets' rotations: the quaternion the next extraction starts from
  *  and its matrix (row-major), 416 bytes. */
@@ -69,16 +76,32 @@ void pose__fem_dyn_tets_build(const pose__fem_mesh *m, pose__fem_dyn_tets *tets,
 void pose__fem_dyn_rot_reset(const pose__fem_mesh *m, pose__fem_dyn_rot *rot);
 
 /**
+ * Tet t turns with the skeleton: its R is the blend of joints' rotations
+ * (n <= 4 joints with weights summing to 1; n = 0: its own deformation's,
+ * the default) instead of the rotation extracted from its deformation
+ * gradient. Its energy is then quadratic in x, R K0 R^T its exact Hessian
+ * (no twist is flagged), and no motion of its own can make R jump. For what
+ * is not tissue: the tets a coarse bake puts outside the skin (between limbs
+ * that touch, around the surface), which deep flexion stretches several
+ * times over and turns inside out, where the extracted rotation changed
+ * branch every few steps and the body never came to rest.
+ */
+void pose__fem_dyn_set_skeletal(pose__fem_dyn_tets *tets, size_t t, int n, const uint32_t *joints,
+                                const float *weights);
+
+/**
  * Blocks [b, e): rotations at x (at most `steps` extraction steps from the
- * last ones), the elastic corner forces of co-rotated linear elasticity at x
+ * last ones; for skeletal tets the blend of their joints' quaternions
+ * {x y z w} at joint_q + POSE__FEM_JOINT_STRIDE j, read only when the blocks
+ * have one), the elastic corner forces of co-rotated linear elasticity at x
  * into f, the products K v with the new rotations into kv (12 rows each),
  * the corners' diagonal stiffness blocks into blk (24 rows), and into flag
  * (one row of 8 per block) all bits set for each tet whose twist stiffness,
  * which K leaves out, may exceed (1 + twist) 2 vmu (fem_dyn_twist.h), else 0.
  */
 void pose__fem_dyn_rotate(const pose__fem_dyn_tets *tets, pose__fem_dyn_rot *rot, const float *x,
-                          const float *v, int steps, float twist, float *f, float *kv, float *blk,
-                          uint32_t *flag, size_t b, size_t e);
+                          const float *joint_q, const float *v, int steps, float twist, float *f,
+                          float *kv, float *blk, uint32_t *flag, size_t b, size_t e);
 /**
  * Blocks [b, e): corner products K u with the last rotations into out (12
  * rows), and each tet's u^T K u into energy (one row of 8 per block).
@@ -89,9 +112,9 @@ void pose__fem_dyn_product(const pose__fem_dyn_tets *tets, const pose__fem_dyn_r
 /* The variants behind the two above. */
 #define POSE__FEM_DYN_VARIANT_DECL(sfx)                                                          \
     void pose__fem_dyn_rotate_##sfx(const pose__fem_dyn_tets *tets, pose__fem_dyn_rot *rot,      \
-                                    const float *x, const float *v, int steps, float twist,      \
-                                    float *f, float *kv, float *blk, uint32_t *flag, size_t b,   \
-                                    size_t e);                                                   \
+                                    const float *x, const float *joint_q, const float *v,         \
+                                    int steps, float twist, float *f, float *kv, float *blk,     \
+                                    uint32_t *flag, size_t b, size_t e);                         \
     void pose__fem_dyn_product_##sfx(const pose__fem_dyn_tets *tets,                             \
                                      const pose__fem_dyn_rot *rot, const float *u, float *out,   \
                                      float *energy, size_t b, size_t e);

@@ -148,10 +148,34 @@ static POSE__INLINE void gather8(const pose__fem_dyn_tets *t, const float *u, po
 #endif
 }
 
+/* A skeletal lane's quaternion: its joints' rotations blended by weight,
+ * each turned into the first one's hemisphere, normalized. */
+static POSE__INLINE void skeletal8(const pose__fem_dyn_tets *t, const float *joint_q, pose__v8f q[4])
+{
+    pose__v8f first[4];
+    for (int c = 0; c < 4; c++)
+        q[c] = first[c] = V8_GATHER(joint_q, t->joint[0], POSE__FEM_JOINT_STRIDE, c);
+    for (int c = 0; c < 4; c++)
+        q[c] *= LOAD8(t->weight[0]);
+    for (int i = 1; i < 4; i++) {
+        pose__v8f p[4];
+        for (int c = 0; c < 4; c++)
+            p[c] = V8_GATHER(joint_q, t->joint[i], POSE__FEM_JOINT_STRIDE, c);
+        const pose__v8f dot = p[0] * first[0] + p[1] * first[1] + p[2] * first[2] + p[3] * first[3];
+        const pose__v8f w = V8_NEG_WHERE(LOAD8(t->weight[i]), dot);
+        for (int c = 0; c < 4; c++)
+            q[c] += w * p[c];
+    }
+    const pose__v8f len =
+        V8_SPLAT(1.0f) / V8_SQRT(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    for (int c = 0; c < 4; c++)
+        q[c] *= len;
+}
+
 void POSE__KV(pose__fem_dyn_rotate)(const pose__fem_dyn_tets *tets, pose__fem_dyn_rot *rot,
-                                    const float *x, const float *v, int steps, float twist,
-                                    float *f, float *kv, float *blk, uint32_t *flag, size_t b,
-                                    size_t e)
+                                    const float *x, const float *joint_q, const float *v,
+                                    int steps, float twist, float *f, float *kv, float *blk,
+                                    uint32_t *flag, size_t b, size_t e)
 {
     const size_t rows = 12 * POSE__FEM_LANES;
     for (size_t k = b; k < e; k++) {
@@ -162,7 +186,25 @@ void POSE__KV(pose__fem_dyn_rotate)(const pose__fem_dyn_tets *tets, pose__fem_dy
         grad8(t, u, F);
         for (int i = 0; i < 4; i++)
             q[i] = LOAD8(ro->q[i]);
-        pose__fem_rotation8(F, q, R, steps);
+        /* skeletal lanes: the joints' blend; the others extract theirs
+         * (a block of skeletal tets only extracts nothing) */
+        const pose__v8i skel = *(const pose__v8i *)(const void *)t->skeletal;
+        if (V8_ANY(skel)) {
+            pose__v8f qs[4], Rs[9];
+            skeletal8(t, joint_q, qs);
+            pose__fem_quat_to_mat8(qs, Rs);
+            if (V8_ANY(~skel))
+                pose__fem_rotation8(F, q, R, steps);
+            else
+                for (int i = 0; i < 9; i++)
+                    R[i] = Rs[i];
+            for (int i = 0; i < 4; i++)
+                q[i] = (pose__v8f)(((pose__v8i)qs[i] & skel) | ((pose__v8i)q[i] & ~skel));
+            for (int i = 0; i < 9; i++)
+                R[i] = (pose__v8f)(((pose__v8i)Rs[i] & skel) | ((pose__v8i)R[i] & ~skel));
+        } else {
+            pose__fem_rotation8(F, q, R, steps);
+        }
         for (int i = 0; i < 4; i++)
             STORE8(ro->q[i], q[i]);
         for (int i = 0; i < 9; i++)
@@ -174,6 +216,7 @@ void POSE__KV(pose__fem_dyn_rotate)(const pose__fem_dyn_tets *tets, pose__fem_dy
         H[8] -= V8_SPLAT(1.0f);
         corners8(t, R, H, 1, f + k * rows, NULL);
         twist8(t, H, twist, flag + k * POSE__FEM_LANES);
+        *(pose__v8i *)(void *)(flag + k * POSE__FEM_LANES) &= ~skel; /* R does not depend on x */
         /* K v with the new rotations: the warm start's product */
         gather8(t, v, u);
         grad8(t, u, F);

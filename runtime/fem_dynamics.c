@@ -505,8 +505,8 @@ static void pass_item(void *ctx, size_t item)
         }
         const size_t g = item - 1, nb = pose__fem_dyn_blocks(m), b = g * POSE__FEM_GROUP;
         const size_t e = b + POSE__FEM_GROUP < nb ? b + POSE__FEM_GROUP : nb;
-        pose__fem_dyn_rotate(d->tets, d->rot, d->x, d->v, FEM_POLAR_STEPS, POSE__FEM_TWIST, d->f,
-                             d->kv, d->blk, d->flag, b, e);
+        pose__fem_dyn_rotate(d->tets, d->rot, d->x, c->prm->joint_q, d->v, FEM_POLAR_STEPS,
+                             POSE__FEM_TWIST, d->f, d->kv, d->blk, d->flag, b, e);
         d->twist_count[g] = (uint32_t)pose__fem_dyn_twist_build(
             d->tets, d->rot, d->flag, d->x, d->v, d->kv, d->blk, b, e,
             d->twist + g * POSE__FEM_GROUP * POSE__FEM_LANES);
@@ -683,13 +683,14 @@ void pose__fem_dyn_step(const pose__fem_mesh *m, pose__fem_work *w, pose__fem_dy
 double pose__fem_dyn_bytes(const pose__fem_mesh *m, double cg_iterations)
 {
     const double nt = (double)m->tet_count, nv = (double)m->vertex_count;
-    /* per tet: rotate (block constants 60, quaternion r+w 32, matrix 36,
+    /* per tet: rotate (block constants 96: 60, the skeletal mask 4 and a
+     * skeletal tet's joints and weights 32; quaternion r+w 32, matrix 36,
      * x and v at 4 corners 96, forces, K v and blocks 192, the twist flag
      * written and read 8), and the residual pass's gathers of its 4
      * corners (index 4 + forces 12 + K v 12 + block 24 each); per vertex:
      * the forces and residual passes (~112 each) and the integration (80).
      * The few flagged tets' twists (fem_dyn_twist.h) are left out. */
-    const double assembly = nt * (60.0 + 32.0 + 36.0 + 96.0 + 192.0 + 8.0 + 4.0 * 52.0) +
+    const double assembly = nt * (96.0 + 32.0 + 36.0 + 96.0 + 192.0 + 8.0 + 4.0 * 52.0) +
                             nv * (112.0 + 112.0 + 80.0);
     /* per iteration: product (block constants 60, rotation 36, u at 4
      * corners 48, products 48, energy 4), the gather of its corners

@@ -57,6 +57,8 @@ typedef struct pose__fem_dyn_params {
      *  response: it may change the simulated vertices' v); NULL: none. */
     void (*constrain)(void *ctx);
     void *constrain_ctx;
+    const float *joint_q; /**< the joints' rotations at the step's end, for skeletal tets
+                               (pose__fem_dyn_rotate); NULL when there are none */
 } pose__fem_dyn_params;
 
 typedef struct pose__fem_dyn_stats {

@@ -72,6 +72,10 @@ static pose_status enable(pose_state *st, const char *fn)
     if (!block)
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "%s: out of memory for the simulation (%zu bytes)",
                           fn, size);
+    if (pose__state_mark_outside_tets(st) < 0) {
+        pose__free(&st->allocator, block);
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "%s: out of memory classifying the tets", fn);
+    }
     st->dyn_block = block;
     restart(st);
     return POSE_OK;
@@ -162,6 +166,7 @@ pose_status pose_step(pose_state *st, double dt)
         .cg_iterations = o->cg_iterations,
         .gravity = {o->gravity[0], o->gravity[1], o->gravity[2]},
         .constrain = push ? constrain : NULL, .constrain_ctx = st,
+        .joint_q = st->palette[0].q, /* skeletal tets' rotations (state_dyn_outside.c) */
     };
     if (push)
         push->step_dt = (float)dt;

@@ -96,6 +96,10 @@ double pose__seconds(void);
 void pose__state_fem_defaults(pose__fem_params *out);
 /** FK, skinning palette and skinning of the tet mesh into tet_positions. */
 void pose__state_skin_pass(pose_state *st);
+/** The simulated tets whose centre lies outside the skin at rest turn
+ *  with the skeleton in the dynamics (state_dyn_outside.c). POSE_OK or
+ *  POSE_ERR_OUT_OF_MEMORY. */
+pose_status pose__state_mark_outside_tets(pose_state *st);
 /** Transfer of tet_positions to the tissues (positions, normals); bone
  *  tissues follow their joint instead (state_bones.c). */
 void pose__state_transfer_pass(pose_state *st);

@@ -5,7 +5,8 @@
  * whole): the product R K0 R^T u plus the twists' equals the central
  * difference of the co-rotated forces along u, and its u^T K u is u . K u;
  * R K0 R^T alone is off by far more; the corners' diagonal blocks are the
- * product's; generic and AVX2 kernels give the same bits. */
+ * product's; generic and AVX2 kernels give the same bits. A skeletal tet
+ * takes its joints' blended rotation and needs no twist. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -87,7 +88,7 @@ static void forces(const pose__fem_dyn_tets *t, const pose__fem_dyn_rot *start, 
     _Alignas(64) pose__fem_dyn_rot rot = *start;
     _Alignas(64) float kv[12 * L], blk[24 * L], v[20] = {0};
     _Alignas(64) uint32_t flag[L];
-    pose__fem_dyn_rotate(t, &rot, x, v, STEPS, POSE__FEM_TWIST, f, kv, blk, flag, 0, 1);
+    pose__fem_dyn_rotate(t, &rot, x, NULL, v, STEPS, POSE__FEM_TWIST, f, kv, blk, flag, 0, 1);
 }
 
 typedef struct product {
@@ -103,7 +104,7 @@ static void stiffness(const pose__fem_dyn_tets *t, pose__fem_dyn_rot *rot, const
     _Alignas(64) float f[12 * L], kv[12 * L], v[20] = {0};
     _Alignas(64) uint32_t flag[L];
     pose__fem_twist list[L];
-    pose__fem_dyn_rotate(t, rot, x, v, STEPS, POSE__FEM_TWIST, f, kv, p->blk, flag, 0, 1);
+    pose__fem_dyn_rotate(t, rot, x, NULL, v, STEPS, POSE__FEM_TWIST, f, kv, p->blk, flag, 0, 1);
     p->flagged = pose__fem_dyn_twist_build(t, rot, flag, x, v, kv, p->blk, 0, 1, list);
     pose__fem_dyn_product(t, rot, u, p->plain, p->energy, 0, 1);
     memcpy(p->out, p->plain, sizeof p->out);
@@ -196,11 +197,92 @@ static void test_stretched_inverted(void **state)
     check(sigma, "inverted");
 }
 
+/* A skeletal tet (pose__fem_dyn_set_skeletal): two joints turned by 0.4
+ * and 0.8 rad about one axis, weighed equally, give it the rotation by
+ * 0.6 rad, whatever its corners do. Turned rigidly by it, no force; at the
+ * stretched, inverted deformation of the test above, not flagged, and its
+ * R K0 R^T u is the forces' central difference (the energy is quadratic
+ * in x: nothing is left out); generic and AVX2 the same bits. */
+static void test_skeletal(void **state)
+{
+    (void)state;
+    static const double n[3] = {0.48, 0.6, 0.64};
+    _Alignas(64) float joint_q[2 * POSE__FEM_JOINT_STRIDE] = {0};
+    for (int j = 0; j < 2; j++) {
+        const double h = 0.5 * (0.4 + 0.4 * j);
+        for (int a = 0; a < 3; a++)
+            joint_q[j * POSE__FEM_JOINT_STRIDE + a] = (float)(sin(h) * n[a]);
+        joint_q[j * POSE__FEM_JOINT_STRIDE + 3] = (float)cos(h);
+    }
+    static const uint32_t joints[2] = {0, 1};
+    static const float weights[2] = {0.5f, 0.5f};
+    _Alignas(64) pose__fem_dyn_tets t;
+    _Alignas(64) pose__fem_dyn_rot rot;
+    one_tet(&t);
+    pose__fem_dyn_set_skeletal(&t, 0, 2, joints, weights);
+    double R[9];
+    rotation(n, 0.6, R);
+
+    /* turned rigidly by R: no force, and R is the tet's rotation */
+    _Alignas(64) float x[20] = {0}, f[12 * L], kv[12 * L], blk[24 * L], v[20] = {0};
+    _Alignas(64) uint32_t flag[L];
+    for (int k = 1; k < 4; k++)
+        for (int a = 0; a < 3; a++)
+            x[3 * k + a] = (float)R[3 * a + k - 1];
+    pose__fem_dyn_rot_reset(&(pose__fem_mesh){.tet_count = 1}, &rot);
+    pose__fem_dyn_rotate(&t, &rot, x, joint_q, v, STEPS, POSE__FEM_TWIST, f, kv, blk, flag, 0, 1);
+    for (int i = 0; i < 9; i++)
+        assert_true(fabs(rot.r[i][0] - R[i]) < 1e-6);
+    for (int i = 0; i < 12; i++)
+        assert_true(fabsf(f[i * L]) < 1e-5f);
+
+    /* stretched and inverted: the plain product is the exact stiffness */
+    static const double sigma[3] = {3.0, 0.5, -0.1};
+    _Alignas(64) pose__fem_dyn_rot start;
+    _Alignas(64) float xp[20], xm[20], fp[12 * L], fm[12 * L], out[12 * L], en[L], u[20] = {0};
+    deform(sigma, x, &start);
+    static const float dir[12] = {0.3f, -0.7f, 0.2f, 0.9f, 0.1f, -0.4f,
+                                  -0.5f, 0.6f, 0.8f, -0.2f, -0.9f, 0.35f};
+    memcpy(u, dir, sizeof dir);
+    const float eps = 1e-3f;
+    memcpy(xp, x, sizeof x);
+    memcpy(xm, x, sizeof x);
+    for (int i = 0; i < 12; i++) {
+        xp[i] += eps * u[i];
+        xm[i] -= eps * u[i];
+    }
+    rot = start;
+    pose__fem_dyn_rotate(&t, &rot, xp, joint_q, v, STEPS, POSE__FEM_TWIST, fp, kv, blk, flag, 0, 1);
+    rot = start;
+    pose__fem_dyn_rotate(&t, &rot, xm, joint_q, v, STEPS, POSE__FEM_TWIST, fm, kv, blk, flag, 0, 1);
+    rot = start;
+    pose__fem_dyn_rotate(&t, &rot, x, joint_q, v, STEPS, POSE__FEM_TWIST, f, kv, blk, flag, 0, 1);
+    assert_int_equal(flag[0], 0);
+    pose__fem_dyn_product(&t, &rot, u, out, en, 0, 1);
+    double fd[12];
+    for (int i = 0; i < 12; i++)
+        fd[i] = -((double)fp[i * L] - fm[i * L]) / (2.0 * eps);
+    const double err = rel_error(out, fd);
+    printf("skeletal, sigma %g %g %g: R K0 R^T u against the forces' difference %.2g\n", sigma[0],
+           sigma[1], sigma[2], err);
+    assert_true(err < 1e-3);
+
+    /* generic kernels: the same bits */
+    _Alignas(64) float fg[12 * L];
+    _Alignas(64) pose__fem_dyn_rot rg = start;
+    pose__kernels_force_generic(1);
+    pose__fem_dyn_rotate(&t, &rg, x, joint_q, v, STEPS, POSE__FEM_TWIST, fg, kv, blk, flag, 0, 1);
+    pose__kernels_force_generic(0);
+    assert_memory_equal(fg, f, sizeof f);
+    assert_memory_equal(&rg, &rot, sizeof rot);
+}
+
 int main(void)
 {
     const struct CMUnitTest all[] = {
         cmocka_unit_test(test_stretched_flat),
         cmocka_unit_test(test_stretched_inverted),
+        cmocka_unit_test(test_skeletal),
     };
     return cmocka_run_group_tests(all, NULL, NULL);
 }

@@ -662,7 +662,13 @@ POSE_API pose_status pose_get_fem_stats(const pose_state *state, pose_fem_stats 
  * zero-length spring, every other bone vertex moves with its bone. Each
  * coupling island (a connected part of the soft tissue) is solved by its
  * own block-Jacobi preconditioned conjugate gradients, warm-started from
- * the last velocities. Then the tet mesh (pose_tet_positions) and every
+ * the last velocities. Soft tets whose centre lies outside the skin at
+ * rest (what a coarse bake fills between limbs that touch and around the
+ * surface) are not tissue: they turn with the skeleton (the blend of the
+ * joints that move their corners) instead of with their own deformation,
+ * which deep flexion stretches several times over and turns inside out;
+ * found when the simulation is allocated (about 0.1 s on the coarse body).
+ * Then the tet mesh (pose_tet_positions) and every
  * tissue (the usual transfer; bone tissues by their joint's rigid motion,
  * as POSE_FEM) show the simulated positions.
  *
