@@ -133,48 +133,20 @@ static double largest_distance(const float *x, const float *y, size_t n)
     return sqrt(worst);
 }
 
-/* Largest distance of a skin vertex (every tissue of kind skin) of a from
- * where it is in b. */
-static double skin_distance(const pose_state *a, const pose_state *b)
-{
-    double worst = 0.0;
-    for (size_t t = 0; t < pose_rig_tissue_count(g_rig); t++) {
-        pose_tissue_info ti;
-        assert_int_equal(pose_rig_tissue_info(g_rig, (int)t, &ti), POSE_OK);
-        if (ti.kind != POSE_TISSUE_SKIN)
-            continue;
-        double d = largest_distance(pose_tissue_positions(a, (int)t, NULL),
-                                    pose_tissue_positions(b, (int)t, NULL), ti.vertex_count);
-        worst = fmax(worst, d);
-    }
-    return worst;
-}
-
-/* The largest move of a skin vertex of st since the positions in prev
- * (every skin tissue's, one after the other), which it then updates. */
-static double skin_step(const pose_state *st, float *prev)
-{
-    double worst = 0.0;
-    for (size_t t = 0; t < pose_rig_tissue_count(g_rig); t++) {
-        pose_tissue_info ti;
-        assert_int_equal(pose_rig_tissue_info(g_rig, (int)t, &ti), POSE_OK);
-        if (ti.kind != POSE_TISSUE_SKIN)
-            continue;
-        const float *x = pose_tissue_positions(st, (int)t, NULL);
-        worst = fmax(worst, largest_distance(x, prev, ti.vertex_count));
-        memcpy(prev, x, 3 * ti.vertex_count * sizeof(float));
-        prev += 3 * ti.vertex_count;
-    }
-    return worst;
-}
-
-static size_t skin_vertices(void)
+/* Every skin tissue's positions in st, one after the other, into out
+ * (NULL: only counted); returns how many vertices. */
+static size_t skin_gather(const pose_state *st, float *out)
 {
     size_t n = 0;
     for (size_t t = 0; t < pose_rig_tissue_count(g_rig); t++) {
         pose_tissue_info ti;
         assert_int_equal(pose_rig_tissue_info(g_rig, (int)t, &ti), POSE_OK);
-        n += ti.kind == POSE_TISSUE_SKIN ? ti.vertex_count : 0;
+        if (ti.kind != POSE_TISSUE_SKIN)
+            continue;
+        if (out)
+            memcpy(out + 3 * n, pose_tissue_positions(st, (int)t, NULL),
+                   3 * ti.vertex_count * sizeof(float));
+        n += ti.vertex_count;
     }
     return n;
 }
@@ -206,8 +178,9 @@ static bend bend_and_hold(const char *const *names, int n, int hold_steps, int u
     pose_tet_info tet;
     assert_int_equal(pose_rig_tet_info(g_rig, &tet), POSE_OK);
     pose_state *st = new_state(2), *skinned = new_state(1);
-    float *prev = malloc(3 * skin_vertices() * sizeof(float));
-    assert_non_null(prev);
+    const size_t ns = skin_gather(st, NULL);
+    float *skin = malloc(3 * 3 * ns * sizeof(float)), *ref = skin + 3 * ns, *prev = ref + 3 * ns;
+    assert_non_null(skin);
     assert_int_equal(pose_set_method(skinned, tet.cor ? POSE_COR : POSE_DQS), POSE_OK);
     assert_int_equal(pose_reset_dynamics(st), POSE_OK);
     bend r = {.settled_s = -1.0};
@@ -227,10 +200,12 @@ static bend bend_and_hold(const char *const *names, int n, int hold_steps, int u
                                     tet.vertex_count);
         assert_true(isfinite(d));
         r.tet_lag = fmax(r.tet_lag, d);
-        r.lag = fmax(r.lag, skin_distance(st, skinned));
-        const double moved = skin_step(st, prev);
+        skin_gather(st, skin);
+        skin_gather(skinned, ref);
+        r.lag = fmax(r.lag, largest_distance(skin, ref, ns));
         if (k > RAMP_STEPS + hold_steps - 60) /* the last 0.5 s */
-            r.still = fmax(r.still, moved);
+            r.still = fmax(r.still, largest_distance(skin, prev, ns));
+        memcpy(prev, skin, 3 * ns * sizeof(float));
         double b = fx_bone_deviation(g_rig, st);
         assert_true(b >= 0.0);
         r.bones = fmax(r.bones, b);
@@ -256,7 +231,7 @@ static bend bend_and_hold(const char *const *names, int n, int hold_steps, int u
            names[0], names[1], n > 2 ? " and the elbows" : "", r.peak, r.ke_end, r.ke_end / r.peak,
            settled, r.after / r.peak, r.lag * 1e3, r.tet_lag * 1e3, r.still * 1e3, r.bones * 1e3,
            r.cg_max);
-    free(prev);
+    free(skin);
     pose_state_free(skinned);
     pose_state_free(st);
     return r;

@@ -121,6 +121,22 @@ static double rel_error(const float *a, const double *b)
     return sqrt(e / n);
 }
 
+/* The central difference's step. */
+#define EPS 1e-3f
+
+/* A direction u over the 4 corners and x moved by +-EPS along it. */
+static void perturb(const float x[20], float u[20], float xp[20], float xm[20])
+{
+    static const float dir[12] = {0.3f, -0.7f, 0.2f, 0.9f, 0.1f, -0.4f,
+                                  -0.5f, 0.6f, 0.8f, -0.2f, -0.9f, 0.35f};
+    memset(u, 0, 20 * sizeof(float));
+    memcpy(u, dir, sizeof dir);
+    for (int i = 0; i < 20; i++) {
+        xp[i] = x[i] + EPS * u[i];
+        xm[i] = x[i] - EPS * u[i];
+    }
+}
+
 static void check(const double sigma[3], const char *what)
 {
     _Alignas(64) pose__fem_dyn_tets t;
@@ -129,21 +145,12 @@ static void check(const double sigma[3], const char *what)
     _Alignas(64) product p;
     one_tet(&t);
     deform(sigma, x, &start);
-    static const float dir[12] = {0.3f, -0.7f, 0.2f, 0.9f, 0.1f, -0.4f,
-                                  -0.5f, 0.6f, 0.8f, -0.2f, -0.9f, 0.35f};
-    memcpy(u, dir, sizeof dir);
-    const float eps = 1e-3f;
-    memcpy(xp, x, sizeof x);
-    memcpy(xm, x, sizeof x);
-    for (int i = 0; i < 12; i++) {
-        xp[i] += eps * u[i];
-        xm[i] -= eps * u[i];
-    }
+    perturb(x, u, xp, xm);
     forces(&t, &start, xp, fp);
     forces(&t, &start, xm, fm);
     double fd[12]; /* K u = -df/dx u */
     for (int i = 0; i < 12; i++)
-        fd[i] = -((double)fp[i * L] - fm[i * L]) / (2.0 * eps);
+        fd[i] = -((double)fp[i * L] - fm[i * L]) / (2.0 * EPS);
     rot = start;
     stiffness(&t, &rot, x, u, &p);
     const double err = rel_error(p.out, fd), err_plain = rel_error(p.plain, fd);
@@ -241,16 +248,7 @@ static void test_skeletal(void **state)
     _Alignas(64) pose__fem_dyn_rot start;
     _Alignas(64) float xp[20], xm[20], fp[12 * L], fm[12 * L], out[12 * L], en[L], u[20] = {0};
     deform(sigma, x, &start);
-    static const float dir[12] = {0.3f, -0.7f, 0.2f, 0.9f, 0.1f, -0.4f,
-                                  -0.5f, 0.6f, 0.8f, -0.2f, -0.9f, 0.35f};
-    memcpy(u, dir, sizeof dir);
-    const float eps = 1e-3f;
-    memcpy(xp, x, sizeof x);
-    memcpy(xm, x, sizeof x);
-    for (int i = 0; i < 12; i++) {
-        xp[i] += eps * u[i];
-        xm[i] -= eps * u[i];
-    }
+    perturb(x, u, xp, xm);
     rot = start;
     pose__fem_dyn_rotate(&t, &rot, xp, joint_q, v, STEPS, POSE__FEM_TWIST, fp, kv, blk, flag, 0, 1);
     rot = start;
@@ -261,7 +259,7 @@ static void test_skeletal(void **state)
     pose__fem_dyn_product(&t, &rot, u, out, en, 0, 1);
     double fd[12];
     for (int i = 0; i < 12; i++)
-        fd[i] = -((double)fp[i * L] - fm[i * L]) / (2.0 * eps);
+        fd[i] = -((double)fp[i * L] - fm[i * L]) / (2.0 * EPS);
     const double err = rel_error(out, fd);
     printf("skeletal, sigma %g %g %g: R K0 R^T u against the forces' difference %.2g\n", sigma[0],
            sigma[1], sigma[2], err);
