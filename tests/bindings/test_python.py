@@ -129,6 +129,25 @@ class Bindings(unittest.TestCase):
             flat = memoryview(state.positions(0)).cast("B").cast("f").tolist()
             self.assertTrue(all(abs(v) < 1e3 for v in flat))
 
+            # couplings: nodes near a bone tied to it, then removed
+            bone = next(t for t in rig.tissues if t.kind == pose.TissueKind.BONE and t.joint >= 0)
+            nodes = rig.fem_nodes_near(bone.joint, 0.05)
+            self.assertGreater(len(nodes), 0)
+            self.assertEqual(nodes, sorted(set(nodes)))
+            with pose.State(rig) as at_rest:
+                rest = memoryview(at_rest.tet_positions()).cast("B").cast("f").tolist()
+            tied = [(n, bone.joint, 100.0, rest[3 * n:3 * n + 3]) for n in nodes[:8]]
+            state.set_fem_couplings(tied)
+            self.assertEqual(state.fem_coupling_count(), len(tied))
+            with self.assertRaises(pose.PoseError) as caught:
+                state.set_fem_couplings([(nodes[0], bone.joint, -1.0, (0.0, 0.0, 0.0))])
+            self.assertEqual(caught.exception.status, pose.Status.INVALID_ARGUMENT)
+            self.assertEqual(state.fem_coupling_count(), len(tied))  # unchanged by the refused call
+            state.step(1 / 120)
+            state.set_fem_couplings([])
+            self.assertEqual(state.fem_coupling_count(), 0)
+            self.assertIsInstance(rig.fem_couplings(), list)
+
     @unittest.skipUnless(CLIP, "no clip given (the bridge is not built)")
     def test_bridge_plays_the_clip(self):
         with pose.Rig(RIG) as rig, pose.State(rig) as state, \

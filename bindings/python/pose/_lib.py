@@ -11,8 +11,8 @@ import ctypes
 import ctypes.util
 import os
 
-from ._types import (BridgeFrame, BridgeOptions, BridgeStatus, DynamicsOptions, DynamicsStats, FemStats,
-                     JointClinical, JointInfo, LoadOptions, StateOptions, TissueInfo, TetInfo, Transform)
+from ._types import (BridgeFrame, BridgeOptions, BridgeStatus, DynamicsOptions, DynamicsStats, FemCoupling,
+                     FemStats, JointClinical, JointInfo, LoadOptions, StateOptions, TissueInfo, TetInfo, Transform)
 
 _here = os.path.dirname(os.path.abspath(__file__))
 
@@ -108,6 +108,10 @@ _declare(libpose, [
     ("pose_step", _status, [_state, ctypes.c_double]),
     ("pose_reset_dynamics", _status, [_state]),
     ("pose_get_dynamics_stats", _status, [_state, P(DynamicsStats)]),
+    ("pose_rig_fem_couplings", _size, [_rig, P(FemCoupling), _size]),
+    ("pose_rig_fem_nodes_near_joint", _status, [_rig, _int, ctypes.c_float, P(ctypes.c_uint32), _size, P(_size)]),
+    ("pose_set_fem_couplings", _status, [_state, P(FemCoupling), _size, _size]),
+    ("pose_fem_coupling_count", _size, [_state]),
 ])
 
 _libbridge = None

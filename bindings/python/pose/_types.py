@@ -93,3 +93,8 @@ class DynamicsStats(ctypes.Structure):
                 ("seconds_cg", ctypes.c_double), ("seconds_transfer", ctypes.c_double),
                 ("contacts", ctypes.c_int), ("contact_iterations", ctypes.c_int),
                 ("max_impulse", ctypes.c_double), ("seconds_contact", ctypes.c_double)]
+
+
+class FemCoupling(ctypes.Structure):
+    _fields_ = [("node", ctypes.c_uint32), ("joint", ctypes.c_int), ("stiffness", ctypes.c_float),
+                ("anchor", _f3)]

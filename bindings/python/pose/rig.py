@@ -7,7 +7,7 @@ import os
 
 from . import _views
 from ._lib import c_float3, libpose
-from ._types import JointClinical, JointInfo, LoadOptions, TissueInfo
+from ._types import FemCoupling, JointClinical, JointInfo, LoadOptions, TissueInfo
 from .errors import PoseError, Status, check
 
 
@@ -137,6 +137,22 @@ class Rig:
     def has_fem(self):
         """Whether the rig has what Method.FEM and State.step() need (its fem section)."""
         return bool(libpose.pose_rig_has_fem(self.handle))
+
+    def fem_nodes_near(self, joint, reach):
+        """Simulation nodes (tet vertex indices) within reach (rig units) of the rest surface of
+        the joint's bone tissues, ascending (pose_rig_fem_nodes_near_joint)."""
+        j, count = self.joint_index(joint), ctypes.c_size_t()
+        check(libpose.pose_rig_fem_nodes_near_joint(self.handle, j, reach, None, 0, ctypes.byref(count)))
+        nodes = (ctypes.c_uint32 * count.value)()
+        check(libpose.pose_rig_fem_nodes_near_joint(self.handle, j, reach, nodes, count.value, ctypes.byref(count)))
+        return list(nodes)
+
+    def fem_couplings(self):
+        """The rig's couplings (its `couplings` section) as (node, joint, stiffness, anchor) tuples."""
+        n = libpose.pose_rig_fem_couplings(self.handle, None, 0)
+        out = (FemCoupling * n)()
+        libpose.pose_rig_fem_couplings(self.handle, out, n)
+        return [(c.node, c.joint, c.stiffness, tuple(c.anchor)) for c in out]
 
     @property
     def metadata(self):

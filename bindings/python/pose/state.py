@@ -5,7 +5,7 @@ import enum
 
 from . import _views
 from ._lib import c_float3, c_float4, libpose
-from ._types import DynamicsOptions, DynamicsStats, FemStats, StateOptions, Transform
+from ._types import DynamicsOptions, DynamicsStats, FemCoupling, FemStats, StateOptions, Transform
 from .errors import PoseError, Status, check
 
 
@@ -139,6 +139,20 @@ class State:
         s = DynamicsStats(size=ctypes.sizeof(DynamicsStats))
         check(libpose.pose_get_dynamics_stats(self.handle, ctypes.byref(s)))
         return {name: getattr(s, name) for name, _ in DynamicsStats._fields_ if name != "size"}
+
+    def set_fem_couplings(self, couplings):
+        """Replace the state's couplings (pose_set_fem_couplings): (node, joint, stiffness,
+        anchor xyz) tuples, each node tied by a zero-length spring to its joint's bone at
+        anchor (rest, model space); [] removes them."""
+        items = list(couplings)
+        array = (FemCoupling * len(items))()
+        for c, (node, joint, stiffness, anchor) in zip(array, items):
+            c.node, c.joint, c.stiffness, c.anchor = node, joint, stiffness, (ctypes.c_float * 3)(*anchor)
+        check(libpose.pose_set_fem_couplings(self.handle, array, len(items), ctypes.sizeof(FemCoupling)))
+
+    def fem_coupling_count(self):
+        """How many of the state's couplings are in effect (on nodes the simulation moves)."""
+        return libpose.pose_fem_coupling_count(self.handle)
 
     # ---- results (views of the state's memory, rewritten by apply())
     def _tissue_array(self, fn, tissue):
