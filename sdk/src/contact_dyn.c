@@ -133,12 +133,10 @@ static void contact_item(void *ctx, size_t item)
             nc[i].depth = 0.0f;
         }
         for (size_t j = 0; j < p->bone_count; j++) {
-            const pose__push_bone *b = &p->bones[j];
-            const float *s = p->bone_spheres + 4 * j, *f = p->frames + 12 * j;
-            const float dx = cluster[0] - s[0], dy = cluster[1] - s[1], dz = cluster[2] - s[2];
-            const float reach = cluster[3] + s[3] + p->margin;
-            if (dx * dx + dy * dy + dz * dz > reach * reach || !pose__push_sphere_near(b, f, cluster, 0))
+            if (!pose__push_cluster_near(p, j, cluster))
                 continue;
+            const pose__push_bone *b = &p->bones[j];
+            const float *f = p->frames + 12 * j;
             for (size_t g = 0; g < groups; g++) {
                 if (!pose__push_sphere_near(b, f, group[g], 0))
                     continue;

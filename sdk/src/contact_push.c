@@ -226,6 +226,15 @@ int pose__push_sphere_near(const pose__push_bone *b, const float *f, const float
     return !(gap > 1 && ((float)gap - 1.0f) * b->cell > reach);
 }
 
+int pose__push_cluster_near(const pose__push *p, size_t j, const float *cluster)
+{
+    const float *s = p->bone_spheres + 4 * j;
+    const float dx = cluster[0] - s[0], dy = cluster[1] - s[1], dz = cluster[2] - s[2];
+    const float reach = cluster[3] + s[3] + p->margin;
+    return dx * dx + dy * dy + dz * dz <= reach * reach &&
+           pose__push_sphere_near(&p->bones[j], p->frames + 12 * j, cluster, 0);
+}
+
 /* Clusters split into items: each vertex is moved by one item, bone after
  * bone in the rig's order, and each item writes its own counts, so any
  * thread count and any assignment of items give the same bits. A cluster
@@ -255,12 +264,10 @@ void pose__state_push_item(void *ctx, size_t item)
          * vertex not yet pushed has not moved: the spheres hold it.) */
         uint8_t done[POSE__PUSH_CLUSTER] = {0};
         for (size_t j = 0; j < p->bone_count; j++) {
-            const pose__push_bone *b = &p->bones[j];
-            const float *s = p->bone_spheres + 4 * j, *f = p->frames + 12 * j;
-            const float dx = cluster[0] - s[0], dy = cluster[1] - s[1], dz = cluster[2] - s[2];
-            const float reach = cluster[3] + s[3] + p->margin;
-            if (dx * dx + dy * dy + dz * dz > reach * reach || !pose__push_sphere_near(b, f, cluster, 0))
+            if (!pose__push_cluster_near(p, j, cluster))
                 continue;
+            const pose__push_bone *b = &p->bones[j];
+            const float *f = p->frames + 12 * j;
             for (size_t g = 0; g < groups; g++) {
                 if (!pose__push_sphere_near(b, f, group[g], 0))
                     continue;

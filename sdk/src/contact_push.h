@@ -139,6 +139,9 @@ void pose__push_sphere(const float *pos, const uint32_t *idx, size_t begin, size
 /** Whether a posed sphere may hold a point bone b (frame f) needs tested
  *  (the grid's gap, per brick unless fine). */
 int pose__push_sphere_near(const pose__push_bone *b, const float *f, const float *sphere, int fine);
+/** Whether a cluster's posed bounding sphere may come within the margin of
+ *  bone j: the bones' spheres first, then pose__push_sphere_near. */
+int pose__push_cluster_near(const pose__push *p, size_t j, const float *cluster);
 /** The dynamic response's nodes (the state's tet mesh's soft nodes), with
  *  the state's allocator. */
 pose_status pose__push_build_nodes(pose__push *push, const struct pose_state *st);
