@@ -307,10 +307,28 @@ static inline float spring_of(const step_ctx *c, size_t v)
                                         : 0.0f;
 }
 
+/* Vertex v's resting contacts' stiffness S (pose__fem_dyn_contact), or
+ * NULL. */
+static inline const float *contact_of(const step_ctx *c, size_t v)
+{
+    return c->prm->contact && c->prm->contact->on[v] ? c->prm->contact->stiff + 6 * v : NULL;
+}
+
 /* A vertex's dot product in double (the passes sum them in double). */
 static inline double dot3(const float *a, const float *b)
 {
     return (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2];
+}
+
+/* kscale u^T S u of a vertex's resting contacts (cs NULL: none): their
+ * part of u^T D u. */
+static inline double contact_energy(const step_ctx *c, const float *cs, const float *u)
+{
+    if (!cs)
+        return 0.0;
+    float su[3];
+    pose__fem_apply_block(cs, u, su);
+    return (double)c->kscale * dot3(su, u);
 }
 
 /* The warm start's residual r = b - A v, b = M v + dt f, with f every
@@ -331,16 +349,23 @@ static void residual_vertex(const step_ctx *c, size_t v, float vp, double sum[PO
     float f[3], kv[3], bv[3], pb[3];
     gather(m, d->corner, d->f, v, f);
     gather(m, d->corner, d->kv, v, kv);
+    /* resting contacts: their force and their share of A v */
+    const float *cs = contact_of(c, v), *cg = cs ? prm->contact->force + 3 * v : NULL;
+    float sv[3] = {0, 0, 0};
+    if (cs)
+        pose__fem_apply_block(cs, vel, sv);
     for (int a = 0; a < 3; a++) {
         const float fa = f[a] + c->vol_force * gv[a] + mass * prm->gravity[a] + ks * (bo[a] - x[a]) +
-                         prm->beta * ks * (bo[a] - bp[a]) / dt;
+                         prm->beta * ks * (bo[a] - bp[a]) / dt + (cg ? cg[a] : 0.0f);
         bv[a] = mass * vel[a] + dt * fa;
-        r[a] = dt * fa - (c->mscale - 1.0f) * mass * vel[a] - c->kscale * (kv[a] + ks * vel[a]) -
+        r[a] = dt * fa - (c->mscale - 1.0f) * mass * vel[a] - c->kscale * (kv[a] + ks * vel[a] + sv[a]) -
                vp * gv[a];
         w->p[3 * v + a] = w->ap[3 * v + a] = 0.0f;
     }
     double k[6];
     vertex_block(m, d->corner, d->blk, v, k);
+    for (int e6 = 0; cs && e6 < 6; e6++)
+        k[e6] += cs[e6];
     for (int e6 = 0; e6 < 6; e6++)
         k[e6] *= c->kscale;
     const double diag = (double)c->mscale * mass + (double)c->kscale * ks;
@@ -357,7 +382,7 @@ static void residual_vertex(const step_ctx *c, size_t v, float vp, double sum[PO
     sum[0] += dot3(r, u);
     sum[1] += dot3(r, r);
     sum[2] += dot3(bv, pb);
-    sum[3] += dd * dot3(u, u);
+    sum[3] += dd * dot3(u, u) + contact_energy(c, cs, u);
     sum[4] += dot3(gv, u);
 }
 
@@ -374,10 +399,13 @@ static void update_vertex(const step_ctx *c, size_t v, float alpha, float beta, 
     float *r = w->r + 3 * v, *u = w->z + 3 * v, *p = w->p + 3 * v, *sv = w->ap + 3 * v;
     float *vel = c->d->v + 3 * v;
     const float *gv = w->gvol + 3 * v;
-    float f[3];
+    const float *cs = contact_of(c, v);
+    float f[3], su[3] = {0, 0, 0};
     gather(m, c->d->corner, c->d->f, v, f);
+    if (cs)
+        pose__fem_apply_block(cs, u, su);
     for (int a = 0; a < 3; a++) {
-        const float wa = c->mscale * mass * u[a] + c->kscale * (f[a] + ks * u[a]) + vp * gv[a];
+        const float wa = c->mscale * mass * u[a] + c->kscale * (f[a] + ks * u[a] + su[a]) + vp * gv[a];
         p[a] = u[a] + beta * p[a];
         sv[a] = wa + beta * sv[a];
         vel[a] += alpha * p[a];
@@ -386,7 +414,7 @@ static void update_vertex(const step_ctx *c, size_t v, float alpha, float beta, 
     pose__fem_apply_block(w->pre + 6 * v, r, u);
     sum[0] += dot3(r, u);
     sum[1] += dot3(r, r);
-    sum[3] += dd * dot3(u, u);
+    sum[3] += dd * dot3(u, u) + contact_energy(c, cs, u);
     sum[4] += dot3(gv, u);
 }
 

@@ -41,6 +41,19 @@
 /** Island of a vertex the solver does not move (bone interior, massless). */
 #define POSE__FEM_KINEMATIC UINT32_MAX
 
+/** Resting contacts (the contact response's, sdk/src/contact_dyn.c)
+ *  inside the solve: at a vertex that rests on bone, a force linear in
+ *  its position, f(x') = g - S (x' - x) with S symmetric positive
+ *  semi-definite (the sum of its contacts' k n n^T): the contacts'
+ *  multipliers and springs toward their planes, as an augmented
+ *  Lagrangian. A node held on bone so stays at rest in the solve instead
+ *  of being pushed in by it and out after it. */
+typedef struct pose__fem_dyn_contact {
+    const uint8_t *on;   /**< per vertex: nonzero where it rests on bone */
+    const float *stiff;  /**< per vertex (6: xx xy xz yy yz zz): S, N/m */
+    const float *force;  /**< per vertex (3): g, the force at x (damping included), N */
+} pose__fem_dyn_contact;
+
 typedef struct pose__fem_dyn_params {
     float dt;             /**< seconds, > 0 */
     float alpha;          /**< Rayleigh mass damping, 1/s */
@@ -57,6 +70,7 @@ typedef struct pose__fem_dyn_params {
      *  response: it may change the simulated vertices' v); NULL: none. */
     void (*constrain)(void *ctx);
     void *constrain_ctx;
+    const pose__fem_dyn_contact *contact; /**< resting contacts' springs, or NULL */
     const float *joint_q; /**< the joints' rotations at the step's end, for skeletal tets
                                (pose__fem_dyn_rotate); NULL when there are none */
 } pose__fem_dyn_params;

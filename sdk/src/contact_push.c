@@ -337,6 +337,8 @@ pose_status pose_set_contact_response(pose_state *st, const pose_contact_respons
             return r;
         }
     }
+    if (s.enabled && !st->push_enabled && st->push->nodes_built) /* contacts from before it was off */
+        pose__push_forget(st->push, st->rig->tet_vertex_count);
     st->push_enabled = s.enabled != 0;
     return POSE_OK;
 }

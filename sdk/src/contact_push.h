@@ -71,6 +71,18 @@ typedef struct pose__push_cache {
     } slot[2];
 } pose__push_cache;
 
+/** Most bones one node of the dynamic response touches at once. */
+#define POSE__PUSH_NODE_BONES 4
+
+/** A node's resting contact on a bone (contact_dyn.c): a plane in the
+ *  bone's rest frame, where the step puts it, and its multiplier. */
+typedef struct pose__push_rest {
+    float q[3], n[3]; /**< a point of the plane and its unit normal out of the bone (rest frame) */
+    float a[3], m[3]; /**< the point and normal posed where the step ends */
+    float force;      /**< the multiplier: force out of the plane, N */
+    uint16_t bone;    /**< index in pose__push.bones */
+} pose__push_rest;
+
 typedef struct pose__push {
     pose_allocator allocator;
     float margin;
@@ -100,6 +112,10 @@ typedef struct pose__push {
                                  of at rest, or UINT16_MAX */
     float *node_gap;        /**< per entry: its distance to that bone at rest: the constraint's
                                  target there (the margin against the others) */
+    uint8_t *rest_count;    /**< per entry: its resting contacts, */
+    pose__push_rest *rests; /**< POSE__PUSH_NODE_BONES per entry */
+    uint8_t *rest_on;       /**< per tet vertex: resting contacts as the solve reads them */
+    float *rest_stiff, *rest_force; /**< (pose__fem_dyn_contact: 6 and 3 per tet vertex) */
     size_t node_count, node_clusters;
     float step_dt;          /**< the step's dt, for the items */
     size_t constraints[POSE__PUSH_ITEMS]; /**< per item of the last step's response */
@@ -111,6 +127,7 @@ typedef struct pose__push {
 } pose__push;
 
 struct pose_state;
+struct pose__fem_dyn_contact;
 
 /** Build everything for the state's rig with the state's allocator (0, or
  *  a pose_status failure with the error set). */
@@ -145,6 +162,13 @@ int pose__push_cluster_near(const pose__push *p, size_t j, const float *cluster)
 /** The dynamic response's nodes (the state's tet mesh's soft nodes), with
  *  the state's allocator. */
 pose_status pose__push_build_nodes(pose__push *push, const struct pose_state *st);
+/** Forget the resting contacts (a restart, or the response turned on
+ *  again): the next step starts without them. */
+void pose__push_forget(pose__push *push, size_t tet_vertex_count);
+/** Before pose_step's solve: the bones where the step ends and the
+ *  resting contacts there (one whose plane has left its node ends), as
+ *  the solve reads them, into *out. */
+void pose__state_contact_rests(struct pose_state *st, float dt, struct pose__fem_dyn_contact *out);
 /** pose_step's response, between the solve and x' = x + dt v' (the state's
  *  dyn.v changed where a soft node would end inside or within the margin
  *  of a bone); the counts into the push's per-item arrays. */

@@ -530,6 +530,11 @@ void pose__push_release(pose__push *p)
     pose__free(a, p->node_cache);
     pose__free(a, p->node_bone);
     pose__free(a, p->node_gap);
+    pose__free(a, p->rest_count);
+    pose__free(a, p->rests);
+    pose__free(a, p->rest_on);
+    pose__free(a, p->rest_stiff);
+    pose__free(a, p->rest_force);
     const pose_allocator keep = *a;
     memset(p, 0, sizeof *p);
     p->allocator = keep;
@@ -611,8 +616,14 @@ pose_status pose__push_build_nodes(pose__push *p, const pose_state *st)
     p->node_bone = pose__alloc(a, (nv + 1) * sizeof *p->node_bone, POSE__ALIGN);
     p->node_gap = pose__alloc(a, (nv + 1) * sizeof *p->node_gap, POSE__ALIGN);
     p->node_cache = pose__alloc(a, (nv + 1) * sizeof *p->node_cache, POSE__ALIGN);
+    p->rest_count = pose__alloc(a, nv + 1, POSE__ALIGN);
+    p->rests = pose__alloc(a, POSE__PUSH_NODE_BONES * (nv + 1) * sizeof *p->rests, POSE__ALIGN);
+    p->rest_on = pose__alloc(a, nv + 1, POSE__ALIGN);
+    p->rest_stiff = pose__alloc(a, 6 * (nv + 1) * sizeof(float), POSE__ALIGN);
+    p->rest_force = pose__alloc(a, 3 * (nv + 1) * sizeof(float), POSE__ALIGN);
     morton_key *k = pose__alloc(a, (nv + 1) * sizeof *k, POSE__ALIGN);
-    if (!p->nodes || !p->node_bone || !p->node_gap || !p->node_cache || !k) {
+    if (!p->nodes || !p->node_bone || !p->node_gap || !p->node_cache || !p->rest_count || !p->rests ||
+        !p->rest_on || !p->rest_stiff || !p->rest_force || !k) {
         pose__free(a, k);
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu nodes of the contact response", nv);
     }
@@ -636,6 +647,7 @@ pose_status pose__push_build_nodes(pose__push *p, const pose_state *st)
     }
     p->node_count = kept;
     p->node_clusters = (kept + POSE__PUSH_CLUSTER - 1) / POSE__PUSH_CLUSTER;
+    pose__push_forget(p, nv);
     p->nodes_built = 1;
     pose__free(a, k);
     return POSE_OK;

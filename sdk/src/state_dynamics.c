@@ -45,6 +45,8 @@ static void restart(pose_state *st)
     pose__state_skin_pass(st);
     pose__state_couplings_bones(st); /* coupled nodes start at their springs' ends */
     pose__fem_dyn_reset(&st->rt->fem, &st->dyn, st->tet_positions);
+    if (st->push && st->push->nodes_built)
+        pose__push_forget(st->push, st->rig->tet_vertex_count);
     memset(&st->dyn_stats, 0, sizeof st->dyn_stats);
     st->dyn_stats.size = sizeof st->dyn_stats;
     st->dyn_stats.islands = (int)st->dyn.island_count;
@@ -174,6 +176,11 @@ pose_status pose_step(pose_state *st, double dt)
     const double t0 = pose__seconds();
     pose__state_skin_pass(st); /* the bones' positions at the end of the step */
     prm.spring = pose__state_couplings_bones(st); /* and the couplings' (state_coupling.c) */
+    pose__fem_dyn_contact rests;
+    if (push) { /* resting contacts, where the bones end (contact_dyn.c) */
+        pose__state_contact_rests(st, (float)dt, &rests);
+        prm.contact = &rests;
+    }
     const double t1 = pose__seconds();
     pose__fem_dyn_stats fs;
     pose__fem_dyn_step(&st->rt->fem, &st->fem_work, &st->dyn, st->pool, &prm, st->tet_positions,

@@ -139,7 +139,15 @@ POSE_API const uint8_t *pose_contact_vertex_flags(const pose_contact *contact, i
  * margin, moved by the response by its predicted depth in bone plus the
  * margin at most, and the velocity change stays in v' (the next step
  * starts from it; a node that was not inside at the start of the step
- * leaves with its bone's normal velocity, no bounce). Then, after the transfer, the skin is pushed out of bone as
+ * leaves with its bone's normal velocity, no bounce). A node the
+ * response pushed rests on that bone from the next step on, inside the
+ * solve: a force out of the plane it was pushed to, a multiplier that
+ * grows over the steps to the load pressing the node there and a
+ * stiffness (30 times the node's own) in the step's system, so that a
+ * posture held costs the solve about what it costs without contact; the
+ * contact ends when the node is beyond the plane by a tenth of the
+ * margin, and never pulls. pose_reset_dynamics, and turning the response
+ * off and on, forget these contacts. Then, after the transfer, the skin is pushed out of bone as
  * pose_apply pushes it (the simulation mesh is coarser than the skin:
  * bone comes through between nodes). Nodes inside a bone at rest are
  * anatomy, left alone. The first pose_step with the response on finds the
