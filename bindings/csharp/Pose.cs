@@ -74,6 +74,16 @@ namespace Pose
         public double MaxImpulse, SecondsContact;
     }
 
+    /// <summary>pose_fem_coupling: a simulation node tied to a joint's bone by a zero-length spring.</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct FemCoupling
+    {
+        public uint Node;        // tet vertex index (State.TetPositions)
+        public int Joint;
+        public float Stiffness;  // multiple of the node's own elastic stiffness, > 0 (pose-bake's default 100)
+        [MarshalAs(UnmanagedType.ByValArray, SizeConst = 3)] public float[] Anchor; // the bone end at rest, model space
+    }
+
     [StructLayout(LayoutKind.Sequential)]
     public struct Transform
     {
@@ -184,6 +194,11 @@ namespace Pose
         [DllImport(Lib)] public static extern Status pose_step(StateHandle state, double dt);
         [DllImport(Lib)] public static extern Status pose_reset_dynamics(StateHandle state);
         [DllImport(Lib)] public static extern Status pose_get_dynamics_stats(StateHandle state, ref DynamicsStats stats);
+        [DllImport(Lib)] public static extern IntPtr pose_tet_positions(StateHandle state, out UIntPtr count);
+        [DllImport(Lib)] public static extern UIntPtr pose_rig_fem_couplings(RigHandle rig, [Out] FemCoupling[] couplings, UIntPtr capacity);
+        [DllImport(Lib)] public static extern Status pose_rig_fem_nodes_near_joint(RigHandle rig, int joint, float reach, [Out] uint[] nodes, UIntPtr capacity, out UIntPtr count);
+        [DllImport(Lib)] public static extern Status pose_set_fem_couplings(StateHandle state, FemCoupling[] couplings, UIntPtr count, UIntPtr elementSize);
+        [DllImport(Lib)] public static extern UIntPtr pose_fem_coupling_count(StateHandle state);
         [DllImport(Bridge)] public static extern Status pose_bridge_open(string source, RigHandle rig, ref BridgeOptions options, out IntPtr bridge);
         [DllImport(Bridge)] public static extern void pose_bridge_close(IntPtr bridge);
         [DllImport(Bridge)] public static extern Status pose_bridge_apply(BridgeHandle bridge, StateHandle state, out BridgeFrame frame);
@@ -290,6 +305,26 @@ namespace Pose
         /// <summary>Rest bounds of one tissue, or (-1) of all: min, max.</summary>
         public void Bounds(int tissue, float[] min, float[] max) { Native.Check(Native.pose_rig_bounds(Handle, tissue, min, max)); }
 
+        /// <summary>Simulation nodes (tet vertex indices) within `reach` rig units of the rest surface of the
+        /// joint's bone tissues, ascending (pose_rig_fem_nodes_near_joint): for setting up, not per frame.</summary>
+        public uint[] FemNodesNear(int joint, float reach)
+        {
+            UIntPtr n;
+            Native.Check(Native.pose_rig_fem_nodes_near_joint(Handle, joint, reach, null, UIntPtr.Zero, out n));
+            var nodes = new uint[(int)n];
+            Native.Check(Native.pose_rig_fem_nodes_near_joint(Handle, joint, reach, nodes, n, out n));
+            return nodes;
+        }
+
+        /// <summary>The rig's couplings (its `couplings` section), sorted by node.</summary>
+        public FemCoupling[] FemCouplings()
+        {
+            var n = Native.pose_rig_fem_couplings(Handle, null, UIntPtr.Zero);
+            var couplings = new FemCoupling[(int)n];
+            Native.pose_rig_fem_couplings(Handle, couplings, n);
+            return couplings;
+        }
+
         public void Dispose() { Handle.Dispose(); }
     }
 
@@ -362,6 +397,28 @@ namespace Pose
             var s = new DynamicsStats { Size = (UIntPtr)Marshal.SizeOf(typeof(DynamicsStats)) };
             Native.Check(Native.pose_get_dynamics_stats(Handle, ref s));
             return s;
+        }
+
+        /// <summary>Replace the state's couplings (pose_set_fem_couplings); an empty array removes them.
+        /// A refused call (InvalidArgument) leaves them as they were.</summary>
+        public void SetFemCouplings(FemCoupling[] couplings)
+        {
+            Native.Check(Native.pose_set_fem_couplings(Handle, couplings, (UIntPtr)couplings.Length,
+                                                       (UIntPtr)Marshal.SizeOf(typeof(FemCoupling))));
+        }
+
+        /// <summary>How many of the state's couplings are in effect (on nodes the simulation moves).</summary>
+        public int FemCouplingCount { get { return (int)Native.pose_fem_coupling_count(Handle); } }
+
+        /// <summary>The tet mesh's vertices after Apply or Step, copied (the nodes couplings name).</summary>
+        public float[] TetPositions()
+        {
+            UIntPtr n;
+            IntPtr p = Native.pose_tet_positions(Handle, out n);
+            var xyz = new float[3 * (int)n];
+            if (p != IntPtr.Zero)
+                Marshal.Copy(p, xyz, 0, xyz.Length);
+            return xyz;
         }
 
         /// <summary>Posed positions of a tissue after Apply into `xyz` (3 per vertex; reuse it every frame).</summary>

@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: Apache-2.0
 # The C# bindings under Debian's mono: compile bindings/csharp/Pose.cs with the
 # console sample (mcs, warnings as errors), run it, and compare every tissue's
-# positions with the C API's (pose_positions) byte for byte; a missing rig is
+# positions with the C API's (pose_positions) byte for byte, check that its
+# couplings are read back and removed; a missing rig is
 # a PoseException naming the file. Exit 77 (skipped) where mono is missing.
 #   csharp_sample.sh POSE_POSITIONS SOURCE_DIR SCRATCH LIBDIRS RIG [CLIP MAP TIME]
 set -euo pipefail
@@ -18,6 +19,7 @@ export LD_LIBRARY_PATH="$libdirs${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 mono "$tmp/sample.exe" "$1" "$tmp/csharp.bin" "${@:2}" | tee "$tmp/sample.log"
 grep -q "format 1; .* bent" "$tmp/sample.log"
 grep -Eq "^dynamics: (6 steps, 0\.0500 s simulated, [1-9][0-9]* islands|unsupported)" "$tmp/sample.log"
+grep -Eq "^(couplings: 8 of [0-9]+ nodes near .*, 8 in effect, 0 after removal|dynamics: unsupported)" "$tmp/sample.log"
 "$helper" "$1" "$tmp/c.bin" "${@:2}"
 cmp "$tmp/csharp.bin" "$tmp/c.bin"
 if mono "$tmp/sample.exe" "$tmp/missing.rig" "$tmp/x.bin" 2>"$tmp/err.log"; then

@@ -52,6 +52,8 @@ class Sample
                     Pose.DynamicsStats s = state.DynamicsStats();
                     Console.WriteLine("dynamics: 6 steps, {0:F4} s simulated, {1} islands, kinetic energy {2:E2} J",
                                       s.Time, s.Islands, s.KineticEnergy);
+                    if (!TieNearBone(rig, state))
+                        return 1;
                 } else {
                     Console.WriteLine("dynamics: unsupported (the rig has no fem section)");
                 }
@@ -61,5 +63,54 @@ class Sample
             return 1;
         }
         return 0;
+    }
+
+    // Couplings: the first 8 nodes within 5 cm of a bone tied to it at their rest positions, the count
+    // read back, a refused call leaving them, a step, and their removal.
+    static bool TieNearBone(Pose.Rig rig, Pose.State state)
+    {
+        int bone = -1;
+        for (int t = 0; t < rig.TissueCount && bone < 0; t++)
+            if (rig.Tissue(t).Kind == Pose.TissueKind.Bone && rig.Tissue(t).Joint >= 0)
+                bone = t;
+        if (bone < 0) {
+            Console.WriteLine("couplings: no bone tissue");
+            return true;
+        }
+        int joint = rig.Tissue(bone).Joint;
+        uint[] nodes = rig.FemNodesNear(joint, 0.05f);
+        if (nodes.Length == 0) {
+            Console.Error.WriteLine("sample: no simulation node within 5 cm of " + rig.Joint(joint).Name);
+            return false;
+        }
+        float[] rest;
+        using (var atRest = new Pose.State(rig))
+            rest = atRest.TetPositions();
+        var tied = new Pose.FemCoupling[Math.Min(8, nodes.Length)];
+        for (int i = 0; i < tied.Length; i++) {
+            uint n = nodes[i];
+            tied[i] = new Pose.FemCoupling { Node = n, Joint = joint, Stiffness = 100,
+                                             Anchor = new[] { rest[3 * n], rest[3 * n + 1], rest[3 * n + 2] } };
+        }
+        state.SetFemCouplings(tied);
+        int count = state.FemCouplingCount;
+        var refused = new Pose.FemCoupling { Node = nodes[0], Joint = joint, Stiffness = -1, Anchor = new float[3] };
+        try {
+            state.SetFemCouplings(new[] { refused });
+            Console.Error.WriteLine("sample: a negative stiffness was accepted");
+            return false;
+        } catch (Pose.PoseException e) {
+            if (e.Status != Pose.Status.InvalidArgument || state.FemCouplingCount != count) {
+                Console.Error.WriteLine("sample: the refused coupling left {0} of {1} ({2})", state.FemCouplingCount,
+                                        count, e.Message);
+                return false;
+            }
+        }
+        state.Step(1.0 / 120);
+        state.SetFemCouplings(new Pose.FemCoupling[0]);
+        Console.WriteLine("couplings: {0} of {1} nodes near {2} tied, {3} in effect, {4} after removal; "
+                          + "the rig has {5}", tied.Length, nodes.Length, rig.Joint(joint).Name, count,
+                          state.FemCouplingCount, rig.FemCouplings().Length);
+        return count == tied.Length && state.FemCouplingCount == 0;
     }
 }
