@@ -62,8 +62,8 @@ static size_t chunk_segments(const pose__fem_mesh *m, const uint32_t *island, si
     return n;
 }
 
-void pose__fem_dyn_islands(const pose__fem_mesh *m, uint32_t *p, size_t *island_count,
-                           size_t *segment_count)
+static void islands_of(const pose__fem_mesh *m, const pose__fem_links *links, uint32_t *p,
+                       size_t *island_count, size_t *segment_count)
 {
     const size_t nv = m->vertex_count;
     for (size_t v = 0; v < nv; v++)
@@ -86,6 +86,11 @@ void pose__fem_dyn_islands(const pose__fem_mesh *m, uint32_t *p, size_t *island_
             unite(p, anchor, tv[c]);
         }
     }
+    /* A soft-soft coupling joins its ends (fem_links.h). */
+    for (size_t i = 0; links && i < links->count; i++)
+        for (int c = 0; c < 4; c++)
+            if (links->weight[4 * i + c] != 0.0f)
+                unite(p, links->node[i], links->corner[4 * i + c]);
     for (size_t v = 0; v < nv; v++)
         p[v] = find(p, (uint32_t)v);
     /* p[v] <= v: a root is numbered before its set's other vertices read it */
@@ -103,6 +108,12 @@ void pose__fem_dyn_islands(const pose__fem_mesh *m, uint32_t *p, size_t *island_
         segs += chunk_segments(m, p, k, NULL, NULL);
     *island_count = islands;
     *segment_count = segs;
+}
+
+void pose__fem_dyn_islands(const pose__fem_mesh *m, uint32_t *p, size_t *island_count,
+                           size_t *segment_count)
+{
+    islands_of(m, NULL, p, island_count, segment_count);
 }
 
 typedef struct layout {
@@ -154,6 +165,37 @@ size_t pose__fem_dyn_size(const pose__fem_mesh *m, size_t islands, size_t segs)
     return layout_of(m, islands, segs).size;
 }
 
+/* The per-island layout from `island` (pose__fem_dyn_islands' numbering,
+ * d->island_count islands and d->segment_count segments): each vertex's,
+ * tet's and group's island, the chunks' segments, the islands' mass scale. */
+static void topology(const pose__fem_mesh *m, const uint32_t *island, pose__fem_dyn *d)
+{
+    memcpy(d->island, island, m->vertex_count * sizeof(uint32_t));
+    for (size_t t = 0; t < m->tet_count; t++) {
+        const uint32_t i = island[m->tets[t].v[0]];
+        d->tet_island[t] = i == POSE__FEM_KINEMATIC ? 0 : i; /* massless: never stepped */
+    }
+    for (size_t g = 0; g < pose__fem_dyn_groups(m); g++) {
+        const size_t b0 = g * POSE__FEM_GROUP * POSE__FEM_LANES;
+        size_t e0 = b0 + POSE__FEM_GROUP * POSE__FEM_LANES;
+        e0 = e0 < m->tet_count ? e0 : m->tet_count;
+        d->group_island[g] = d->tet_island[b0];
+        for (size_t t = b0; t < e0; t++)
+            if (d->tet_island[t] != d->group_island[g])
+                d->group_island[g] = POSE__FEM_KINEMATIC; /* mixed */
+    }
+    size_t n = 0;
+    for (size_t k = 0; k < m->chunk_count; k++) {
+        d->seg_offset[k] = (uint32_t)n;
+        n += chunk_segments(m, island, k, d->seg_first + n, d->seg_island + n);
+    }
+    d->seg_offset[m->chunk_count] = (uint32_t)n;
+    memset(d->isl, 0, d->island_count * sizeof(pose__fem_island));
+    for (size_t v = 0; v < m->vertex_count; v++)
+        if (island[v] != POSE__FEM_KINEMATIC)
+            d->isl[island[v]].mm += 3e-4 * (double)m->mass[v];
+}
+
 void pose__fem_dyn_init(const pose__fem_mesh *m, const uint32_t *island, size_t islands,
                         size_t segs, void *memory, pose__fem_dyn *d)
 {
@@ -189,32 +231,10 @@ void pose__fem_dyn_init(const pose__fem_mesh *m, const uint32_t *island, size_t 
         .alpha = (float *)(b + l.alpha),
         .beta = (float *)(b + l.beta),
     };
-    memcpy(d->island, island, m->vertex_count * sizeof(uint32_t));
     pose__fem_dyn_tets_build(m, d->tets, d->rot);
     for (size_t k = 0; k < m->corner_offset[m->vertex_count]; k++)
         d->corner[k] = (uint32_t)pose__fem_dyn_corner(m->corners[k], 12);
-    for (size_t t = 0; t < m->tet_count; t++) {
-        const uint32_t i = island[m->tets[t].v[0]];
-        d->tet_island[t] = i == POSE__FEM_KINEMATIC ? 0 : i; /* massless: never stepped */
-    }
-    for (size_t g = 0; g < pose__fem_dyn_groups(m); g++) {
-        const size_t b0 = g * POSE__FEM_GROUP * POSE__FEM_LANES;
-        size_t e0 = b0 + POSE__FEM_GROUP * POSE__FEM_LANES;
-        e0 = e0 < m->tet_count ? e0 : m->tet_count;
-        d->group_island[g] = d->tet_island[b0];
-        for (size_t t = b0; t < e0; t++)
-            if (d->tet_island[t] != d->group_island[g])
-                d->group_island[g] = POSE__FEM_KINEMATIC; /* mixed */
-    }
-    size_t n = 0;
-    for (size_t k = 0; k < m->chunk_count; k++) {
-        d->seg_offset[k] = (uint32_t)n;
-        n += chunk_segments(m, island, k, d->seg_first + n, d->seg_island + n);
-    }
-    d->seg_offset[m->chunk_count] = (uint32_t)n;
-    for (size_t v = 0; v < m->vertex_count; v++)
-        if (island[v] != POSE__FEM_KINEMATIC)
-            d->isl[island[v]].mm += 3e-4 * (double)m->mass[v];
+    topology(m, island, d);
     /* Each vertex's stiffness at rest (the trace / 3 of its 3x3 block,
      * invariant under rotation): what the bone springs are scaled by. */
     for (size_t t = 0; t < m->tet_count; t++) {
@@ -228,6 +248,16 @@ void pose__fem_dyn_init(const pose__fem_mesh *m, const uint32_t *island, size_t 
                 (float)(tt->vmu * gg + ((double)tt->vkappa + tt->vmu / 3.0) * gg / 3.0);
         }
     }
+}
+
+void pose__fem_dyn_link(const pose__fem_mesh *m, const pose__fem_links *links, uint32_t *scratch,
+                        pose__fem_dyn *d)
+{
+    size_t ni, ns; /* at most the block's: linking only merges islands and their runs */
+    islands_of(m, links, scratch, &ni, &ns);
+    d->island_count = ni;
+    d->segment_count = ns;
+    topology(m, scratch, d);
 }
 
 void pose__fem_dyn_reset(const pose__fem_mesh *m, pose__fem_dyn *d, const float *bones)
@@ -346,6 +376,10 @@ static void residual_vertex(const step_ctx *c, size_t v, float vp, double sum[PO
     float *r = w->r + 3 * v, *u = w->z + 3 * v, *pre = w->pre + 6 * v;
     const float *vel = d->v + 3 * v, *gv = w->gvol + 3 * v, *x = d->x + 3 * v;
     const float *bo = c->bones + 3 * v, *bp = d->bone_prev + 3 * v;
+    /* the soft-soft couplings (fem_links.h; zero where none reaches):
+     * their force -K_l x and K_l v, formed before the pass, and diagonal */
+    const pose__fem_links *l = prm->links;
+    const float kl = l ? l->diag[v] : 0.0f;
     float f[3], kv[3], bv[3], pb[3];
     gather(m, d->corner, d->f, v, f);
     gather(m, d->corner, d->kv, v, kv);
@@ -355,11 +389,15 @@ static void residual_vertex(const step_ctx *c, size_t v, float vp, double sum[PO
     if (cs)
         pose__fem_apply_block(cs, vel, sv);
     for (int a = 0; a < 3; a++) {
-        const float fa = f[a] + c->vol_force * gv[a] + mass * prm->gravity[a] + ks * (bo[a] - x[a]) +
-                         prm->beta * ks * (bo[a] - bp[a]) / dt + (cg ? cg[a] : 0.0f);
+        float fa = f[a] + c->vol_force * gv[a] + mass * prm->gravity[a] + ks * (bo[a] - x[a]) +
+                   prm->beta * ks * (bo[a] - bp[a]) / dt + (cg ? cg[a] : 0.0f);
+        float ka = kv[a] + ks * vel[a] + sv[a];
+        if (l) {
+            fa -= l->out[3 * v + (size_t)a];
+            ka += l->out2[3 * v + (size_t)a];
+        }
         bv[a] = mass * vel[a] + dt * fa;
-        r[a] = dt * fa - (c->mscale - 1.0f) * mass * vel[a] - c->kscale * (kv[a] + ks * vel[a] + sv[a]) -
-               vp * gv[a];
+        r[a] = dt * fa - (c->mscale - 1.0f) * mass * vel[a] - c->kscale * ka - vp * gv[a];
         w->p[3 * v + a] = w->ap[3 * v + a] = 0.0f;
     }
     double k[6];
@@ -368,7 +406,7 @@ static void residual_vertex(const step_ctx *c, size_t v, float vp, double sum[PO
         k[e6] += cs[e6];
     for (int e6 = 0; e6 < 6; e6++)
         k[e6] *= c->kscale;
-    const double diag = (double)c->mscale * mass + (double)c->kscale * ks;
+    const double diag = (double)c->mscale * mass + (double)c->kscale * (ks + kl);
     k[0] += diag;
     k[3] += diag;
     k[5] += diag;
@@ -387,7 +425,7 @@ static void residual_vertex(const step_ctx *c, size_t v, float vp, double sum[PO
 }
 
 /* One Chronopoulos-Gear CG iteration at a vertex: w = A u (the gathered
- * K u, the diagonal D = mscale M + kscale K_s, the volume term's rank one
+ * K u with the couplings' K_l u, the diagonal D = mscale M + kscale K_s, the volume term's rank one
  * vp g), p = u + beta p, s = w + beta s (= A p), v += alpha p,
  * r -= alpha s, u = P r. Sums: r.u, r.r, -, u.(D u), g.u. */
 static void update_vertex(const step_ctx *c, size_t v, float alpha, float beta, float vp,
@@ -400,11 +438,15 @@ static void update_vertex(const step_ctx *c, size_t v, float alpha, float beta, 
     float *vel = c->d->v + 3 * v;
     const float *gv = w->gvol + 3 * v;
     const float *cs = contact_of(c, v);
+    /* K_l u, formed between the product and this pass (fem_links.h) */
+    const float *lu = c->prm->links ? c->prm->links->out + 3 * v : NULL;
     float f[3], su[3] = {0, 0, 0};
     gather(m, c->d->corner, c->d->f, v, f);
     if (cs)
         pose__fem_apply_block(cs, u, su);
     for (int a = 0; a < 3; a++) {
+        if (lu)
+            f[a] += lu[a];
         const float wa = c->mscale * mass * u[a] + c->kscale * (f[a] + ks * u[a] + su[a]) + vp * gv[a];
         p[a] = u[a] + beta * p[a];
         sv[a] = wa + beta * sv[a];
@@ -596,6 +638,25 @@ static void run(step_ctx *c, pose__pool *pool, int pass)
     }
 }
 
+/* The soft-soft couplings' K_l u for the update pass and each island's
+ * u^T K_l u (vertex after vertex: one order for any thread count), while u
+ * holds still between the product and the update. */
+static void links_product(step_ctx *c)
+{
+    const pose__fem_links *l = c->prm->links;
+    pose__fem_dyn *d = c->d;
+    for (size_t i = 0; i < d->island_count; i++)
+        d->isl[i].link = 0.0;
+    if (!l)
+        return;
+    pose__fem_links_product(l, c->w->z, NULL, 0.0f, l->out);
+    for (size_t i = 0; i < l->touched_count; i++) {
+        const size_t v = l->touched[i];
+        if (d->island[v] != POSE__FEM_KINEMATIC) /* massless: never stepped */
+            d->isl[d->island[v]].link += dot3(c->w->z + 3 * v, l->out + 3 * v);
+    }
+}
+
 static double now(void)
 {
     return 1e-9 * (double)pose__now_ns();
@@ -623,6 +684,10 @@ void pose__fem_dyn_step(const pose__fem_mesh *m, pose__fem_work *w, pose__fem_dy
      * tets (the skin's volume term as one more item), then per vertex the right-hand side, the preconditioner (blocks
      * of A) and the residual of the warm start v. */
     run(&c, pool, PASS_ROTATE); /* with the volume term beside the tets */
+    if (prm->links) { /* K_l x and K_l v for the residual pass (fem_links.h: one thread) */
+        pose__fem_links_product(prm->links, d->x, NULL, 0.0f, prm->links->out);
+        pose__fem_links_product(prm->links, d->v, NULL, 0.0f, prm->links->out2);
+    }
     run(&c, pool, PASS_RESIDUAL);
     const double tol2 = (double)prm->tolerance * prm->tolerance;
     int any = 0;
@@ -653,11 +718,12 @@ void pose__fem_dyn_step(const pose__fem_mesh *m, pose__fem_work *w, pose__fem_dy
      * where plain CG takes three and two). */
     for (int it = 0; it < prm->cg_iterations && any; it++) {
         run(&c, pool, PASS_PRODUCT);
+        links_product(&c);
         for (size_t i = 0; i < ni; i++) {
             pose__fem_island *is = &d->isl[i];
             if (!is->active)
                 continue;
-            const double uau = c.kscale * is->tet + is->dm + kg * is->gu * is->gu;
+            const double uau = c.kscale * (is->tet + is->link) + is->dm + kg * is->gu * is->gu;
             const double den = is->iterations == 0 ? uau : uau - d->beta[i] * is->rz / is->alpha;
             if (!(den > 0.0)) {
                 is->active = 0;

@@ -18,8 +18,9 @@
  *
  * Bones being kinematic, coupling islands are the connected parts of the
  * soft tissue (tets sharing vertices; the skin's volume term joins every
- * vertex it touches). Each island runs its own block-Jacobi preconditioned
- * CG (its own step lengths and stopping test), warm-started from the last
+ * vertex it touches, a soft-soft coupling its ends). Each island runs its
+ * own block-Jacobi preconditioned CG (its own step lengths and stopping
+ * test), warm-started from the last
  * velocities, in Chronopoulos and Gear's form (one product, one vertex
  * pass and one reduction per iteration). Reductions are summed per segment
  * (a run of one island's vertices inside a POSE__FEM_CHUNK) and then
@@ -63,6 +64,9 @@ typedef struct pose__fem_dyn_params {
      *  stiffness of a zero-length spring tying a simulated vertex to its
      *  entry in `bones` (the coupling's target), damped as the bone nodes'. */
     const float *spring;
+    /** Soft-soft couplings (fem_links.h), or NULL; every end a vertex the
+     *  solver moves, the islands linked with them (pose__fem_dyn_link). */
+    const pose__fem_links *links;
     float tolerance;      /**< per island: stop at r^T P r <= tolerance^2 max(b^T P b, mm) */
     int cg_iterations;    /**< most CG iterations per island and step */
     float gravity[3];     /**< rig units / s^2 */
@@ -100,6 +104,7 @@ typedef struct pose__fem_island {
     double dm;              /**< u^T D u, D = (1 + dt alpha) M + kscale K_s: A's diagonal part */
     double gu;              /**< the volume gradient . u (. v before the residual pass) */
     double tet;             /**< the tets' u^T K u, summed by the last product pass */
+    double link;            /**< the soft-soft couplings' u^T K_l u, of the same product */
     double alpha;           /**< the last step length */
     int iterations;
     int active;             /**< still iterating */
@@ -150,6 +155,14 @@ static inline size_t pose__fem_dyn_groups(const pose__fem_mesh *m)
  */
 void pose__fem_dyn_islands(const pose__fem_mesh *mesh, uint32_t *island, size_t *island_count,
                            size_t *segment_count);
+/**
+ * The islands again with the soft-soft couplings `links` (NULL: none)
+ * joining what they tie (Otaduy §5.2), rewritten in place: fewer islands
+ * and segments than the block was laid out for from pose__fem_dyn_islands.
+ * `scratch`: a vertex count of uint32_t. Velocities and positions stay.
+ */
+void pose__fem_dyn_link(const pose__fem_mesh *mesh, const pose__fem_links *links,
+                        uint32_t *scratch, pose__fem_dyn *dyn);
 /** Bytes of pose__fem_dyn_init's block. */
 size_t pose__fem_dyn_size(const pose__fem_mesh *mesh, size_t island_count, size_t segment_count);
 /** Lay the block out from pose__fem_dyn_islands' result; velocities zero,

@@ -519,23 +519,29 @@ static void vertices_pass(solve_ctx *c, size_t chunk)
         e = m->vertex_count;
     double s0 = 0.0, s1 = 0.0, s2 = 0.0;
     const float *spring = c->prm->spring;
+    const pose__fem_links *links = c->prm->links;
     for (size_t v = b; v < e; v++) {
         const float id = m->inv_diag[v];
         /* a coupling's zero-length spring (free vertices only) */
         const float ks = spring && id > 0.0f ? spring[v] : 0.0f;
+        /* the soft-soft couplings' product at v, formed before the pass
+         * (K_l x, then K_l (z + beta p)), and their diagonal */
+        const float *lo = links && id > 0.0f ? links->out + 3 * v : NULL;
         float *r = w->r + 3 * v, *z = w->z + 3 * v, *p = w->p + 3 * v, *ap = w->ap + 3 * v;
         const float *gv = w->gvol + 3 * v;
         if (c->pass == PASS_GATHER_RESIDUAL) {
             float f[3];
             pose__fem_gather(m, w->corner, v, f);
             float *pre = w->pre + 6 * v;
-            vertex_preconditioner(m, w->dblk, v, ks, pre);
+            vertex_preconditioner(m, w->dblk, v, lo ? ks + links->diag[v] : ks, pre);
             const float *xt = ks > 0.0f ? c->prm->target + 3 * v : NULL, *xv = c->x + 3 * v;
             for (int a = 0; a < 3; a++) {
                 r[a] = id > 0.0f ? f[a] + m->mass[v] * c->prm->gravity[a] + c->vol_force * gv[a]
                                  : 0.0f;
                 if (xt)
                     r[a] += ks * (xt[a] - xv[a]);
+                if (lo)
+                    r[a] -= lo[a];
                 p[a] = 0.0f;
             }
             pose__fem_apply_block(pre, r, z);
@@ -548,7 +554,7 @@ static void vertices_pass(solve_ctx *c, size_t chunk)
             pose__fem_gather(m, w->corner, v, f);
             for (int a = 0; a < 3; a++) {
                 p[a] = z[a] + c->beta * p[a];
-                ap[a] = id > 0.0f ? f[a] + ks * p[a] : 0.0f;
+                ap[a] = id > 0.0f ? f[a] + ks * p[a] + (lo ? lo[a] : 0.0f) : 0.0f;
                 s0 += (double)p[a] * ap[a];
                 s2 += (double)p[a] * gv[a];
             }
@@ -680,6 +686,8 @@ void pose__fem_solve(const pose__fem_mesh *m, pose__fem_work *w, pose__pool *poo
         double t0 = now();
         run(&c, pool, PASS_ROTATE, NULL, NULL, NULL);
         c.vol_force = (float)pose__fem_volume_gradient(m, w, x);
+        if (prm->links) /* their force -K_l x (fem_links.h: one thread) */
+            pose__fem_links_product(prm->links, x, NULL, 0.0f, prm->links->out);
         double rz = 0.0;
         run(&c, pool, PASS_GATHER_RESIDUAL, &rz, &rr, NULL);
         double t1 = now();
@@ -695,6 +703,8 @@ void pose__fem_solve(const pose__fem_mesh *m, pose__fem_work *w, pose__pool *poo
         for (; it < prm->cg_iterations; it++) {
             double pap = 0.0, pg = 0.0;
             run(&c, pool, PASS_PRODUCT, NULL, NULL, NULL);
+            if (prm->links) /* K_l p' with p' = z + beta p, as the tets form it */
+                pose__fem_links_product(prm->links, w->z, w->p, c.beta, prm->links->out);
             run(&c, pool, PASS_GATHER_PRODUCT, &pap, NULL, &pg);
             c.vol_product = (float)(m->surface.stiffness * pg);
             pap += m->surface.stiffness * pg * pg;

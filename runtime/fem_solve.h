@@ -15,6 +15,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "fem_links.h"
 #include "fem_mesh.h"
 #include "rt_pool.h"
 
@@ -28,6 +29,8 @@ typedef struct pose__fem_params {
      *  target (3 per vertex; read where spring > 0). */
     const float *spring;
     const float *target;
+    /** Soft-soft couplings (fem_links.h), or NULL; every end a free vertex. */
+    const pose__fem_links *links;
 } pose__fem_params;
 
 typedef struct pose__fem_stats {

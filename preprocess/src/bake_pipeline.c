@@ -316,7 +316,8 @@ static int write_rig(const pp_bake_options *o, bake_state *s, pp_bake_report *re
                           s->w.weights,       s->cor,        rep->tissue_count,
                           s->tissues,         meta,          s->clinical,
                           o->no_fem ? NULL : &fem, o->volume_count, o->volumes,
-                          s->coupling_count,  s->couplings};
+                          s->coupling_count,  s->couplings,
+                          0,                  NULL};
     /* Write beside the target, then rename: a reader never sees half a rig. */
     size_t len = strlen(o->output_path) + 32;
     char *tmp = malloc(len);

@@ -18,6 +18,7 @@ const char *pose__section_name(uint32_t type)
     case POSE__SEC_CLINICAL: return "clinical";
     case POSE__SEC_FEM: return "fem";
     case POSE__SEC_COUPLINGS: return "couplings";
+    case POSE__SEC_SOFT_COUPLINGS: return "soft_couplings";
     default: return "unknown";
     }
 }
@@ -25,7 +26,8 @@ const char *pose__section_name(uint32_t type)
 bool pose__section_known(uint32_t type)
 {
     return (type >= POSE__SEC_SKELETON && type <= POSE__SEC_METADATA) || type == POSE__SEC_CLINICAL ||
-           type == POSE__SEC_FEM || type == POSE__SEC_VOLUMES || type == POSE__SEC_COUPLINGS;
+           type == POSE__SEC_FEM || type == POSE__SEC_VOLUMES || type == POSE__SEC_COUPLINGS ||
+           type == POSE__SEC_SOFT_COUPLINGS;
 }
 
 pose__skeleton_layout pose__skeleton_layout_of(uint64_t joints)
@@ -77,6 +79,11 @@ uint64_t pose__clinical_size_of(uint64_t joints)
 uint64_t pose__couplings_size_of(uint64_t count)
 {
     return POSE__RIG_SECTION_HEADER + pose__align64(count * POSE__RIG_COUPLING_RECORD);
+}
+
+uint64_t pose__soft_couplings_size_of(uint64_t count)
+{
+    return POSE__RIG_SECTION_HEADER + pose__align64(count * POSE__RIG_SOFT_COUPLING_RECORD);
 }
 
 uint64_t pose__tissue_data_size(uint64_t vertices, uint64_t triangles)

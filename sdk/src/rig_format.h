@@ -59,7 +59,8 @@ typedef enum pose__section_type {
     POSE__SEC_VOLUMES = 7, /* rest images on voxel grids (pose/volume.h) */
     POSE__SEC_CLINICAL = 8, /* neutral posture, clinical axes and ranges per joint */
     POSE__SEC_FEM = 9,      /* soft tissue material for POSE_FEM */
-    POSE__SEC_COUPLINGS = 10 /* soft nodes tied to bones (pose_fem_coupling) */
+    POSE__SEC_COUPLINGS = 10, /* soft nodes tied to bones (pose_fem_coupling) */
+    POSE__SEC_SOFT_COUPLINGS = 11 /* soft nodes tied to each other (pose_fem_soft_coupling) */
 } pose__section_type;
 
 /** Printable name of a section type ("skeleton", ...; "unknown" otherwise). */
@@ -97,6 +98,9 @@ uint64_t pose__clinical_size_of(uint64_t joints);
 /** The couplings section: header (count), then 32-byte records. */
 #define POSE__RIG_COUPLING_RECORD 32u
 uint64_t pose__couplings_size_of(uint64_t count);
+/** The soft_couplings section: header (count), then 40-byte records. */
+#define POSE__RIG_SOFT_COUPLING_RECORD 40u
+uint64_t pose__soft_couplings_size_of(uint64_t count);
 /** The volumes section: header (count), 128-byte records, then each
  *  volume's arrays (rig_volumes.c). */
 #define POSE__RIG_VOLUME_RECORD 128u

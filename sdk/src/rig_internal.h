@@ -69,6 +69,23 @@ typedef struct pose__coupling_record {
 } pose__coupling_record;
 _Static_assert(sizeof(pose__coupling_record) == 32, "coupling record is 32 bytes on disk");
 
+/** One soft-soft coupling as stored in the optional `soft_couplings`
+ *  section (40 bytes, little-endian; docs/rig-format.md): the layout of
+ *  pose.h's pose_fem_soft_coupling of 0.2. */
+typedef struct pose__soft_coupling_record {
+    uint32_t node;        /* < tet vertices */
+    uint32_t other[4];    /* < tet vertices where weighted, distinct, none `node` */
+    float weight[4];      /* finite, summing to 1 */
+    float stiffness;      /* finite, > 0 */
+} pose__soft_coupling_record;
+_Static_assert(sizeof(pose__soft_coupling_record) == 40, "soft coupling record is 40 bytes on disk");
+
+/** Why a soft coupling record is malformed for a mesh of `tet_vertices`
+ *  (into why, at most `cap` bytes), with the byte offset of the field at
+ *  fault in *at; 0 when it is well formed (rig_soft_couplings.c). */
+int pose__soft_coupling_fault(const pose__soft_coupling_record *r, size_t tet_vertices, char *why,
+                              size_t cap, size_t *at);
+
 /** One tissue surface; arrays point into the rig's storage. */
 typedef struct pose__tissue {
     const char *name;         /* NUL-terminated, < POSE__NAME_SIZE bytes */
@@ -103,6 +120,8 @@ struct pose_rig {
     const pose__fem_record *fem;           /* soft tissue material, or NULL (no POSE_FEM) */
     const pose__coupling_record *couplings;/* coupling_count records, or NULL (no section) */
     size_t coupling_count;
+    const pose__soft_coupling_record *soft_couplings; /* soft_coupling_count, or NULL */
+    size_t soft_coupling_count;
     const uint8_t *volumes;                /* the volumes section (checked), or NULL */
     uint32_t volume_count;
 

@@ -63,6 +63,9 @@ pose_status pose__fem_validate(const pose_rig *rig, const pose__source *src);
 /** The couplings section's records: nodes and joints in range, nodes
  *  strictly increasing, values finite, reserved bytes zero; needs `fem`. */
 pose_status pose__couplings_validate(const pose_rig *rig, const pose__source *src);
+/** The soft_couplings section's records (pose__soft_coupling_fault); needs
+ *  `fem` (rig_soft_couplings.c). */
+pose_status pose__soft_couplings_validate(const pose_rig *rig, const pose__source *src);
 
 /** Map and check the volumes section (bytes p .. p + size of src) into
  *  rig->volumes (rig_volumes.c). */

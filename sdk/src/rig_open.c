@@ -401,6 +401,30 @@ static pose_status map_couplings(const pose__source *src, const entry *s, pose_r
     return POSE_OK;
 }
 
+/* Soft coupling records (count in the header); their values are checked
+ * by rig_soft_couplings.c. */
+static pose_status map_soft_couplings(const pose__source *src, const entry *s, pose_rig *rig)
+{
+    const uint8_t *p = src->base + s->offset;
+    pose_status st = need_header(src, s);
+    if (st != POSE_OK)
+        return st;
+    uint32_t count = get_u32(p);
+    if (count == 0)
+        return pose__source_fail(src, POSE_ERR_FORMAT, "soft_couplings", p,
+                                 "0 soft couplings (a rig without them has no section)");
+    if (!all_zero(p + 4, POSE__RIG_SECTION_HEADER - 4))
+        return pose__source_fail(src, POSE_ERR_FORMAT, "soft_couplings", p + 4,
+                                 "reserved header bytes are not zero");
+    if (s->size != pose__soft_couplings_size_of(count))
+        return size_mismatch(src, s, pose__soft_couplings_size_of(count),
+                             "its soft coupling count");
+    rig->soft_couplings =
+        (const pose__soft_coupling_record *)(const void *)(p + POSE__RIG_SECTION_HEADER);
+    rig->soft_coupling_count = count;
+    return POSE_OK;
+}
+
 /* Tissue records hold counts and offsets; the offsets must follow the one
  * canonical layout, which rules out overlaps and misalignment at once. */
 static pose_status map_tissues(const pose__source *src, const entry *s, pose_rig *rig,
@@ -490,6 +514,8 @@ static pose_status map_sections(const pose__source *src, const entry *e, uint32_
         st = map_fem(src, find(e, n, POSE__SEC_FEM), rig);
     if (st == POSE_OK && find(e, n, POSE__SEC_COUPLINGS))
         st = map_couplings(src, find(e, n, POSE__SEC_COUPLINGS), rig);
+    if (st == POSE_OK && find(e, n, POSE__SEC_SOFT_COUPLINGS))
+        st = map_soft_couplings(src, find(e, n, POSE__SEC_SOFT_COUPLINGS), rig);
     if (st == POSE_OK && find(e, n, POSE__SEC_VOLUMES))
         st = pose__map_volumes(src, src->base + find(e, n, POSE__SEC_VOLUMES)->offset,
                                find(e, n, POSE__SEC_VOLUMES)->size, rig);

@@ -242,6 +242,8 @@ pose_status pose__rig_validate(const pose_rig *rig, const pose__source *src)
         st = pose__fem_validate(rig, src);
     if (st == POSE_OK)
         st = pose__couplings_validate(rig, src);
+    if (st == POSE_OK)
+        st = pose__soft_couplings_validate(rig, src);
     pose__free(&rig->allocator, refs);
     return st;
 }

@@ -109,6 +109,12 @@ static pose_status check_desc(const pose_rig_desc *d)
                           "rig description: %zu fem couplings need the couplings array and fem "
                           "(the soft tissue's material), at most %u",
                           d->fem_coupling_count, POSE__RIG_MAX_COUNT);
+    if (d->fem_soft_coupling_count && (!d->fem_soft_couplings || !d->fem ||
+                                       d->fem_soft_coupling_count > POSE__RIG_MAX_COUNT))
+        return pose__fail(POSE_ERR_INVALID_ARGUMENT,
+                          "rig description: %zu fem soft couplings need their array and fem (the "
+                          "soft tissue's material), at most %u",
+                          d->fem_soft_coupling_count, POSE__RIG_MAX_COUNT);
     pose_status st = check_clinical(d);
     return st == POSE_OK ? pose__volumes_check_desc(d) : st;
 }
@@ -223,6 +229,14 @@ static void write_couplings(uint8_t *s, const pose_rig_desc *d)
     }
 }
 
+static void write_soft_couplings(uint8_t *s, const pose_rig_desc *d)
+{
+    put_u32(s, (uint32_t)d->fem_soft_coupling_count);
+    for (size_t i = 0; i < d->fem_soft_coupling_count; i++) /* the record is the 0.2 struct */
+        memcpy(s + POSE__RIG_SECTION_HEADER + i * POSE__RIG_SOFT_COUPLING_RECORD,
+               &d->fem_soft_couplings[i], POSE__RIG_SOFT_COUPLING_RECORD);
+}
+
 static void write_tissues(uint8_t *s, const pose_rig_desc *d)
 {
     put_u32(s, (uint32_t)d->tissue_count);
@@ -259,7 +273,7 @@ pose_status pose__rig_serialize(const pose_rig_desc *d, const pose_allocator *al
         return st;
     size_t meta_len = d->metadata ? strlen(d->metadata) : 0;
 
-    section_plan plan[11];
+    section_plan plan[12];
     uint32_t n = 0;
     plan[n++] = (section_plan){POSE__SEC_SKELETON, 0, pose__skeleton_layout_of(d->joint_count).size};
     plan[n++] = (section_plan){POSE__SEC_TETMESH, 0,
@@ -278,6 +292,9 @@ pose_status pose__rig_serialize(const pose_rig_desc *d, const pose_allocator *al
     if (d->fem_coupling_count)
         plan[n++] = (section_plan){POSE__SEC_COUPLINGS, 0,
                                    pose__couplings_size_of(d->fem_coupling_count)};
+    if (d->fem_soft_coupling_count)
+        plan[n++] = (section_plan){POSE__SEC_SOFT_COUPLINGS, 0,
+                                   pose__soft_couplings_size_of(d->fem_soft_coupling_count)};
     if (d->volume_count)
         plan[n++] = (section_plan){POSE__SEC_VOLUMES, 0, pose__volumes_size_of(d)};
 
@@ -305,6 +322,7 @@ pose_status pose__rig_serialize(const pose_rig_desc *d, const pose_allocator *al
         case POSE__SEC_CLINICAL: write_clinical(s, d); break;
         case POSE__SEC_FEM: write_fem(s, d); break;
         case POSE__SEC_COUPLINGS: write_couplings(s, d); break;
+        case POSE__SEC_SOFT_COUPLINGS: write_soft_couplings(s, d); break;
         case POSE__SEC_VOLUMES: pose__volumes_write(s, d); break;
         case POSE__SEC_METADATA:
             put_u64(s, meta_len);
@@ -315,7 +333,8 @@ pose_status pose__rig_serialize(const pose_rig_desc *d, const pose_allocator *al
         put_u32(e + POSE__ENT_TYPE, plan[i].type);
         /* Readers before pose 0.2 skip what they do not know only when it is optional. */
         if (plan[i].type == POSE__SEC_CLINICAL || plan[i].type == POSE__SEC_FEM ||
-            plan[i].type == POSE__SEC_VOLUMES || plan[i].type == POSE__SEC_COUPLINGS)
+            plan[i].type == POSE__SEC_VOLUMES || plan[i].type == POSE__SEC_COUPLINGS ||
+            plan[i].type == POSE__SEC_SOFT_COUPLINGS)
             put_u32(e + POSE__ENT_FLAGS, POSE__SECTION_OPTIONAL);
         put_u64(e + POSE__ENT_OFFSET, plan[i].offset);
         put_u64(e + POSE__ENT_SIZE, plan[i].size);

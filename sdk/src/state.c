@@ -168,6 +168,8 @@ pose_status pose_state_create_ex(const pose_rig *rig, const pose_state_options *
         return s;
     }
     s = pose__state_couplings_init(st); /* state_coupling.c: the rig's couplings */
+    if (s == POSE_OK)
+        s = pose__state_links_init(st); /* state_links.c: and its soft-soft ones */
     if (s < 0) {
         pose_state_free(st);
         return s;
@@ -189,6 +191,7 @@ void pose_state_free(pose_state *st)
     }
     pose__state_push_free(st);
     pose__state_couplings_free(st);
+    pose__state_links_free(st);
     pose__free(&alloc, st->block);
 }
 

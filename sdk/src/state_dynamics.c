@@ -68,8 +68,10 @@ static pose_status enable(pose_state *st, const char *fn)
     pose__fem_dyn_islands(m, island, &ni, &ns);
     const size_t size = pose__fem_dyn_size(m, ni, ns);
     void *block = pose__alloc(&st->allocator, size, POSE__ALIGN);
-    if (block)
+    if (block) {
         pose__fem_dyn_init(m, island, ni, ns, block, &st->dyn);
+        pose__state_links_islands(st, island); /* joined by soft couplings (state_links.c) */
+    }
     pose__free(&st->allocator, island);
     if (!block)
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "%s: out of memory for the simulation (%zu bytes)",
@@ -176,6 +178,7 @@ pose_status pose_step(pose_state *st, double dt)
     const double t0 = pose__seconds();
     pose__state_skin_pass(st); /* the bones' positions at the end of the step */
     prm.spring = pose__state_couplings_bones(st); /* and the couplings' (state_coupling.c) */
+    prm.links = pose__state_links(st);             /* soft-soft couplings (state_links.c) */
     pose__fem_dyn_contact rests;
     if (push) { /* resting contacts, where the bones end (contact_dyn.c) */
         pose__state_contact_rests(st, (float)dt, &rests);

@@ -93,6 +93,7 @@ void pose__state_fem_refine(pose_state *st)
      * 0.22 % of its volume, 0.03 % when started at the ends). */
     prm.spring = pose__state_couplings_bones(st);
     prm.target = st->cpl_target;
+    prm.links = pose__state_links(st); /* soft-soft couplings (state_links.c) */
     pose__fem_solve(&st->rt->fem, &st->fem_work, st->pool, &prm, st->tet_positions, &s);
     st->fem_stats.outer_iterations = s.outer_iterations;
     st->fem_stats.cg_iterations = s.cg_iterations;

@@ -58,6 +58,9 @@ struct pose_state {
     float *cpl_anchor;          /**< 3 per coupling: rest model space */
     float *cpl_spring;          /**< per tet vertex: spring stiffness (0: not coupled) */
     float *cpl_target;          /**< 3 per tet vertex: the spring's bone end this frame */
+    /* Soft-soft couplings (state_links.c): own allocation, NULL when none is in effect */
+    void *lnk_block;
+    pose__fem_links links;      /**< links.count: the ones in effect */
     struct pose__push *push;    /**< pose_set_contact_response (contact_push.c): own
                                      allocations, NULL until first enabled */
     int push_enabled;
@@ -121,6 +124,15 @@ const float *pose__state_couplings_place(pose_state *st);
  *  st->tet_positions at the coupled nodes (the dynamics' springs pull
  *  toward `bones`). */
 const float *pose__state_couplings_bones(pose_state *st);
+/** A new state's soft-soft couplings: the rig's (state_links.c). */
+pose_status pose__state_links_init(pose_state *st);
+void pose__state_links_free(pose_state *st);
+/** The soft-soft couplings for the solvers, or NULL when none is in effect. */
+const pose__fem_links *pose__state_links(pose_state *st);
+/** The simulation's islands joined by the soft-soft couplings (after it is
+ *  laid out, and whenever they change); `scratch`: a tet vertex count of
+ *  uint32_t. */
+void pose__state_links_islands(pose_state *st, uint32_t *scratch);
 /** pose_apply's FEM refinement of st->tet_positions (after skinning). */
 void pose__state_fem_refine(pose_state *st);
 

@@ -543,7 +543,7 @@ static void test_section_table_entries(void **state)
     memcpy(img, im.data, im.size);
     memset(img + im.size, 0x5A, 64);
     uint8_t *e = rb_entry(img, 5);
-    rb_put_u32(e, 11); /* reserved for future pose sections: unknown here */
+    rb_put_u32(e, 12); /* reserved for future pose sections: unknown here */
     rb_put_u32(e + 4, 1);
     rb_put_u64(e + 8, im.size);
     rb_put_u64(e + 16, 64);

@@ -442,6 +442,12 @@ typedef struct pose_rig_desc {
      *  NULL. Stored in the optional `couplings` section; needs `fem`. @since 0.2 */
     size_t fem_coupling_count;
     const struct pose_fem_coupling *fem_couplings;
+    /** Soft nodes tied to other soft nodes or to points of the tet mesh by
+     *  zero-length springs (struct pose_fem_soft_coupling),
+     *  fem_soft_coupling_count entries, or 0 / NULL. Stored in the optional
+     *  `soft_couplings` section; needs `fem`. @since 0.2 */
+    size_t fem_soft_coupling_count;
+    const struct pose_fem_soft_coupling *fem_soft_couplings;
 } pose_rig_desc;
 
 /**
@@ -803,6 +809,65 @@ POSE_API pose_status pose_set_fem_couplings(pose_state *state, const pose_fem_co
 /** The state's couplings in effect (the ones on nodes the simulation moves):
  *  their count. @since 0.2 */
 POSE_API size_t pose_fem_coupling_count(const pose_state *state);
+
+/**
+ * Soft-soft couplings (Otaduy et al. §4.2, §5.2): a soft simulation node
+ * tied by a zero-length spring to a point of the tet mesh, the weighted sum
+ * of up to 4 other nodes' positions: another node (other {b}, weight {1})
+ * or, as pose-bake places them, the point of another part's tet where the
+ * node lies at rest (its corners and barycentric weights), so the spring
+ * is slack at rest and holds the two parts together as they move, e.g.
+ * fascia to the muscle under it, or two separately meshed parts where
+ * they touch. The spring's stiffness is `stiffness` times the node's own
+ * elastic stiffness at rest, as pose_fem_coupling's. POSE_FEM adds it to
+ * its equilibrium, pose_step to its forces, stiffness and damping (Rayleigh
+ * beta on the relative velocity); in pose_step the parts a coupling ties
+ * become one coupling island, solved together (pose_dynamics_stats.islands
+ * counts them). Other methods ignore them.
+ *
+ * A rig's soft couplings (its optional `soft_couplings` section: pose-bake
+ * resolves a template's "couplings" between two parts, or
+ * pose_rig_desc.fem_soft_couplings) are a new state's;
+ * pose_set_fem_soft_couplings replaces a state's without a rebake. A
+ * coupling whose node or any weighted node is not moved freely by the
+ * simulation (a vertex of a bone tet, or of no soft tet) is ignored, as a
+ * pose_fem_coupling on such a node is.
+ *
+ * ABI: arrays are passed with their element size
+ * (sizeof(pose_fem_soft_coupling)); a later version may append fields,
+ * read or written only where the element size covers them.
+ */
+typedef struct pose_fem_soft_coupling {
+    uint32_t node;     /**< simulation node: tet vertex index (pose_tet_positions) */
+    uint32_t other[4]; /**< the spring's other end: sum of weight[c] times node other[c]'s
+                            position (a weight of 0 leaves its node unused) */
+    float weight[4];   /**< finite, summing to 1 (within 1e-4), at least one nonzero;
+                            no weighted node is `node` or repeats another */
+    float stiffness;   /**< multiple of the node's own elastic stiffness, finite, > 0
+                            (pose-bake's default 100, as pose_fem_coupling's) */
+} pose_fem_soft_coupling;
+
+/** The rig's soft couplings: copies min(count, capacity) of them, each
+ *  element_size bytes apart (its first sizeof(pose_fem_soft_coupling) of 0.2
+ *  written), to out (may be NULL with capacity 0) and returns the count (0
+ *  without a `soft_couplings` section, for a NULL rig or an element_size
+ *  below the 0.2 layout). @since 0.2 */
+POSE_API size_t pose_rig_fem_soft_couplings(const pose_rig *rig, pose_fem_soft_coupling *out,
+                                            size_t capacity, size_t element_size);
+/** Replace the state's soft couplings by `count` entries of `element_size`
+ *  bytes each (>= sizeof(pose_fem_soft_coupling) of 0.2; NULL / 0: none):
+ *  every node < tet vertex count, weights as pose_fem_soft_coupling says,
+ *  stiffness finite and > 0 (else POSE_ERR_INVALID_ARGUMENT naming the
+ *  entry, the state's soft couplings unchanged). Allocates with the
+ *  state's allocator (a running simulation's islands are joined again
+ *  here, its velocities kept); pose_apply and pose_step still allocate
+ *  nothing. POSE_ERR_UNSUPPORTED for a rig without a fem section. @since 0.2 */
+POSE_API pose_status pose_set_fem_soft_couplings(pose_state *state,
+                                                 const pose_fem_soft_coupling *couplings,
+                                                 size_t count, size_t element_size);
+/** The state's soft couplings in effect (every end moved freely by the
+ *  simulation): their count. @since 0.2 */
+POSE_API size_t pose_fem_soft_coupling_count(const pose_state *state);
 
 /* ---------------------------------------------------------------- bounds */
 
