@@ -30,10 +30,10 @@ int main(int argc, char **argv)
     }
     const char *dir = argv[1];
     int bad = 0;
-    static const struct { const char *name; int cor, meta, clinical, couplings; } valid[] = {
-        {"valid_tiny_full.rig", 1, 1, 0, 0}, {"valid_tiny_no_cor.rig", 0, 1, 0, 0},
-        {"valid_tiny_minimal.rig", 0, 0, 0, 0}, {"valid_tiny_clinical.rig", 1, 1, 1, 0},
-        {"valid_tiny_couplings.rig", 1, 1, 0, 1},
+    static const struct { const char *name; int cor, meta, clinical, couplings, soft; } valid[] = {
+        {"valid_tiny_full.rig", 1, 1, 0, 0, 0}, {"valid_tiny_no_cor.rig", 0, 1, 0, 0, 0},
+        {"valid_tiny_minimal.rig", 0, 0, 0, 0, 0}, {"valid_tiny_clinical.rig", 1, 1, 1, 0, 0},
+        {"valid_tiny_couplings.rig", 1, 1, 0, 1, 0}, {"valid_tiny_soft_couplings.rig", 1, 1, 0, 0, 1},
     };
     uint8_t *img;
     size_t size = 0;
@@ -44,6 +44,8 @@ int main(int argc, char **argv)
             tiny_rig_add_clinical(&t);
         if (valid[i].couplings)
             tiny_rig_add_couplings(&t);
+        if (valid[i].soft)
+            tiny_rig_add_soft_couplings(&t);
         void *data;
         if (pose_rig_write_memory(&t.desc, NULL, &data, &size) != POSE_OK) {
             fprintf(stderr, "rigfile_make_seeds: %s\n", pose_last_error());
@@ -104,6 +106,18 @@ int main(int argc, char **argv)
     rb_put_u32(img + rb_offset(img, SEC_COUPLINGS) + 64 + 32, 12);
     rb_fix_crcs(img, size);
     bad |= save(dir, "bad_coupling_node.rig", img, size);
+    free(img);
+
+    /* a soft coupling's weights summing to 0.75 (fem and soft_couplings) */
+    tiny_rig_init(&t, 1, 1);
+    tiny_rig_add_soft_couplings(&t);
+    if (pose_rig_write_memory(&t.desc, NULL, &data, &size) != POSE_OK)
+        return 1;
+    img = data;
+    const float quarter = 0.25f; /* weight 2 of record 1: 0.5 -> 0.25 */
+    memcpy(img + rb_offset(img, SEC_SOFT_COUPLINGS) + 64 + 40 + 28, &quarter, 4);
+    rb_fix_crcs(img, size);
+    bad |= save(dir, "bad_soft_coupling_weights.rig", img, size);
     free(img);
     return bad;
 }

@@ -10,7 +10,7 @@
 #include <string.h>
 
 enum { SEC_SKELETON = 1, SEC_TETMESH, SEC_WEIGHTS, SEC_COR, SEC_TISSUES, SEC_METADATA, SEC_VOLUMES,
-       SEC_CLINICAL, SEC_FEM, SEC_COUPLINGS };
+       SEC_CLINICAL, SEC_FEM, SEC_COUPLINGS, SEC_SOFT_COUPLINGS };
 /* A clinical record: 192 bytes per joint after the section's 64-byte header. */
 enum { CLIN_FLAGS = 0, CLIN_LIMIT_FLAGS = 4, CLIN_NEUTRAL = 8, CLIN_AXES = 24, CLIN_MIN = 60,
        CLIN_MAX = 72, CLIN_RESERVED = 84, CLIN_NAMES = 96, CLIN_RECORD = 192 };

@@ -1204,6 +1204,112 @@ static void test_couplings(void **state)
     assert_non_null(strstr(pose_last_error(), "node 12 is not a tet vertex"));
 }
 
+/* The soft_couplings section (type 11, optional): round trip, what a state
+ * makes of it, damage named with its record and byte, descriptions, and
+ * rigs without it. */
+static void test_soft_couplings(void **state)
+{
+    (void)state;
+    tiny_rig t;
+    tiny_rig_init(&t, 1, 1);
+    tiny_rig_add_soft_couplings(&t);
+    image im = write_image(&t.desc);
+    int e = rb_find(im.data, SEC_SOFT_COUPLINGS);
+    assert_true(e >= 0);
+    assert_int_equal(rb_u32(rb_entry(im.data, (uint32_t)e) + 4), 1); /* OPTIONAL: 0.1 skips it */
+    assert_int_equal(rb_u64(rb_entry(im.data, (uint32_t)e) + 16), 64 + 128);
+    const uint64_t sec = rb_offset(im.data, SEC_SOFT_COUPLINGS), r1 = sec + 64 + 40;
+    assert_int_equal(rb_u32(im.data + sec), 2);
+    pose_rig *rig;
+    assert_int_equal(pose_rig_load_memory(im.data, im.size, NULL, &rig), POSE_OK);
+    pose_fem_soft_coupling got[3];
+    assert_int_equal(pose_rig_fem_soft_couplings(rig, NULL, 0, sizeof got[0]), 2);
+    assert_int_equal(pose_rig_fem_soft_couplings(rig, got, 3, sizeof got[0]), 2);
+    assert_memory_equal(got, t.soft_couplings, sizeof t.soft_couplings);
+    assert_int_equal(pose_rig_fem_soft_couplings(rig, got, 3, sizeof got[0] - 1), 0);
+    /* a later caller's larger element: the 0.2 part written, the rest left */
+    struct {
+        pose_fem_soft_coupling c;
+        uint32_t later;
+    } wide[2] = {{.later = 77}, {.later = 78}};
+    assert_int_equal(pose_rig_fem_soft_couplings(rig, &wide[0].c, 2, sizeof wide[0]), 2);
+    assert_memory_equal(&wide[1].c, &t.soft_couplings[1], sizeof wide[1].c);
+    assert_int_equal(wide[0].later, 77);
+    assert_int_equal(wide[1].later, 78);
+    /* a state takes them: vertices 8-11 are in soft tets only */
+    pose_state *st;
+    assert_int_equal(pose_state_create(rig, &st), POSE_OK);
+    assert_int_equal(pose_fem_soft_coupling_count(st), 2);
+    pose_state_free(st);
+    pose_rig_free(rig);
+
+    uint8_t *keep = malloc(im.size);
+    assert_non_null(keep);
+    memcpy(keep, im.data, im.size);
+    rb_put_u32(im.data + r1, 12); /* node */
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 3, "section 'soft_couplings'",
+                      "soft coupling 1: node 12 is not a tet vertex (12)", at(r1));
+    memcpy(im.data, keep, im.size);
+    rb_put_u32(im.data + r1 + 8, 9); /* other[1] is the node */
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 2, "other node 1 (9) is the node",
+                      at(r1 + 8));
+    memcpy(im.data, keep, im.size);
+    rb_put_u32(im.data + r1 + 8, 40); /* other[1] past the mesh */
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 2, "other node 1 (40)", at(r1 + 8));
+    memcpy(im.data, keep, im.size);
+    put_f32(&im, r1 + 24, NAN);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 2, "weight 1 is not finite",
+                      at(r1 + 24));
+    memcpy(im.data, keep, im.size);
+    put_f32(&im, r1 + 28, 0.25f);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 2, "weights sum to 0.75", at(r1 + 20));
+    memcpy(im.data, keep, im.size);
+    put_f32(&im, r1 + 36, 0.0f);
+    expect_load_error(im.data, im.size, POSE_ERR_INVALID_DATA, 2, "soft coupling 1: stiffness 0",
+                      at(r1 + 36));
+    memcpy(im.data, keep, im.size);
+    rb_put_u32(im.data + sec, 4); /* count: the size no longer matches (3 fits the padding) */
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_FORMAT, 1, "section 'soft_couplings'");
+    memcpy(im.data, keep, im.size);
+    rb_put_u32(im.data + sec, 0);
+    rb_fix_crcs(im.data, im.size);
+    expect_load_error(im.data, im.size, POSE_ERR_FORMAT, 2, "0 soft couplings", at(sec));
+    free(keep);
+    free(im.data);
+
+    /* Descriptions: soft couplings need fem; the checks run on pose_rig_create. */
+    t.desc.fem = NULL;
+    assert_int_equal(pose_rig_create(&t.desc, NULL, &rig), POSE_ERR_INVALID_ARGUMENT);
+    t.desc.fem = &t.fem;
+    t.soft_couplings[0].other[0] = 8;
+    assert_int_equal(pose_rig_create(&t.desc, NULL, &rig), POSE_ERR_INVALID_DATA);
+    assert_non_null(strstr(pose_last_error(), "soft coupling 0: other node 0 (8) is the node"));
+
+    /* Without them: no section; the committed seeds. */
+    tiny_rig_init(&t, 1, 1);
+    im = write_image(&t.desc);
+    assert_int_equal(rb_find(im.data, SEC_SOFT_COUPLINGS), -1);
+    free(im.data);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/valid_tiny_couplings.rig", POSE_RIG_CORPUS);
+    assert_int_equal(pose_rig_load(path, &rig), POSE_OK);
+    assert_int_equal(pose_rig_fem_soft_couplings(rig, got, 3, sizeof got[0]), 0);
+    pose_rig_free(rig);
+    snprintf(path, sizeof path, "%s/valid_tiny_soft_couplings.rig", POSE_RIG_CORPUS);
+    assert_int_equal(pose_rig_load(path, &rig), POSE_OK);
+    assert_int_equal(pose_rig_fem_soft_couplings(rig, got, 3, sizeof got[0]), 2);
+    pose_rig_free(rig);
+    snprintf(path, sizeof path, "%s/bad_soft_coupling_weights.rig", POSE_RIG_CORPUS);
+    rig = (pose_rig *)1;
+    assert_int_equal(pose_rig_load(path, &rig), POSE_ERR_INVALID_DATA);
+    assert_null(rig);
+    assert_non_null(strstr(pose_last_error(), "soft coupling 1: weights sum to 0.75"));
+}
+
 static void test_status_strings_and_version(void **state)
 {
     (void)state;
@@ -1246,6 +1352,7 @@ int main(void)
         cmocka_unit_test(test_clinical_damage),
         cmocka_unit_test(test_clinical_description_errors),
         cmocka_unit_test(test_couplings),
+        cmocka_unit_test(test_soft_couplings),
         cmocka_unit_test(test_status_strings_and_version),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

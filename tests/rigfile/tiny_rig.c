@@ -151,3 +151,15 @@ void tiny_rig_add_couplings(tiny_rig *t)
     t->desc.fem_coupling_count = 2;
     t->desc.fem_couplings = t->couplings;
 }
+
+void tiny_rig_add_soft_couplings(tiny_rig *t)
+{
+    t->fem = (pose_fem_material){1e4f, 0.45f, 1000.0f};
+    t->soft_couplings[0] = (pose_fem_soft_coupling){
+        .node = 8, .other = {11}, .weight = {1.0f}, .stiffness = 50.0f};
+    t->soft_couplings[1] = (pose_fem_soft_coupling){
+        .node = 9, .other = {10, 11, 8}, .weight = {0.25f, 0.25f, 0.5f}, .stiffness = 2.5f};
+    t->desc.fem = &t->fem;
+    t->desc.fem_soft_coupling_count = 2;
+    t->desc.fem_soft_couplings = t->soft_couplings;
+}

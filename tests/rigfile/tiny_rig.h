@@ -27,6 +27,7 @@ typedef struct tiny_rig {
     pose_joint_clinical clinical[3];
     pose_fem_material fem;
     pose_fem_coupling couplings[2];
+    pose_fem_soft_coupling soft_couplings[2];
     pose_rig_desc desc;
 } tiny_rig;
 
@@ -40,5 +41,8 @@ void tiny_rig_add_clinical(tiny_rig *t);
 /** Add the optional fem and couplings sections: two soft nodes (vertices 9
  *  and 10, of cube 1) tied to the elbow and the wrist. */
 void tiny_rig_add_couplings(tiny_rig *t);
+/** Add the optional fem and soft_couplings sections: vertex 8 tied to
+ *  vertex 11, vertex 9 to a point of 10, 11 and 8 (cube 1's free nodes). */
+void tiny_rig_add_soft_couplings(tiny_rig *t);
 
 #endif /* POSE_TEST_TINY_RIG_H */
