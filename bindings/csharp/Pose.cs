@@ -84,6 +84,23 @@ namespace Pose
         [MarshalAs(UnmanagedType.ByValArray, SizeConst = 3)] public float[] Anchor; // the bone end at rest, model space
     }
 
+    /// <summary>pose_fem_soft_coupling: a simulation node tied by a zero-length spring to the point
+    /// sum(Weight[c] * x[Other[c]]) of up to 4 other nodes (a node pair: Other {b}, Weight {1}).</summary>
+    [StructLayout(LayoutKind.Sequential)]
+    public struct FemSoftCoupling
+    {
+        public uint Node;
+        [MarshalAs(UnmanagedType.ByValArray, SizeConst = 4)] public uint[] Other;
+        [MarshalAs(UnmanagedType.ByValArray, SizeConst = 4)] public float[] Weight; // summing to 1; 0: unused
+        public float Stiffness;  // multiple of the node's own elastic stiffness, > 0
+
+        public static FemSoftCoupling Pair(uint node, uint other, float stiffness)
+        {
+            return new FemSoftCoupling { Node = node, Other = new uint[] { other, 0, 0, 0 },
+                                         Weight = new float[] { 1, 0, 0, 0 }, Stiffness = stiffness };
+        }
+    }
+
     [StructLayout(LayoutKind.Sequential)]
     public struct Transform
     {
@@ -199,6 +216,9 @@ namespace Pose
         [DllImport(Lib)] public static extern Status pose_rig_fem_nodes_near_joint(RigHandle rig, int joint, float reach, [Out] uint[] nodes, UIntPtr capacity, out UIntPtr count);
         [DllImport(Lib)] public static extern Status pose_set_fem_couplings(StateHandle state, FemCoupling[] couplings, UIntPtr count, UIntPtr elementSize);
         [DllImport(Lib)] public static extern UIntPtr pose_fem_coupling_count(StateHandle state);
+        [DllImport(Lib)] public static extern UIntPtr pose_rig_fem_soft_couplings(RigHandle rig, [Out] FemSoftCoupling[] couplings, UIntPtr capacity, UIntPtr elementSize);
+        [DllImport(Lib)] public static extern Status pose_set_fem_soft_couplings(StateHandle state, FemSoftCoupling[] couplings, UIntPtr count, UIntPtr elementSize);
+        [DllImport(Lib)] public static extern UIntPtr pose_fem_soft_coupling_count(StateHandle state);
         [DllImport(Bridge)] public static extern Status pose_bridge_open(string source, RigHandle rig, ref BridgeOptions options, out IntPtr bridge);
         [DllImport(Bridge)] public static extern void pose_bridge_close(IntPtr bridge);
         [DllImport(Bridge)] public static extern Status pose_bridge_apply(BridgeHandle bridge, StateHandle state, out BridgeFrame frame);
@@ -325,6 +345,16 @@ namespace Pose
             return couplings;
         }
 
+        /// <summary>The rig's soft-soft couplings (its `soft_couplings` section).</summary>
+        public FemSoftCoupling[] FemSoftCouplings()
+        {
+            var size = (UIntPtr)Marshal.SizeOf(typeof(FemSoftCoupling));
+            var n = Native.pose_rig_fem_soft_couplings(Handle, null, UIntPtr.Zero, size);
+            var couplings = new FemSoftCoupling[(int)n];
+            Native.pose_rig_fem_soft_couplings(Handle, couplings, n, size);
+            return couplings;
+        }
+
         public void Dispose() { Handle.Dispose(); }
     }
 
@@ -409,6 +439,17 @@ namespace Pose
 
         /// <summary>How many of the state's couplings are in effect (on nodes the simulation moves).</summary>
         public int FemCouplingCount { get { return (int)Native.pose_fem_coupling_count(Handle); } }
+
+        /// <summary>Replace the state's soft-soft couplings (pose_set_fem_soft_couplings); an empty array
+        /// removes them. A refused call (InvalidArgument) leaves them as they were.</summary>
+        public void SetFemSoftCouplings(FemSoftCoupling[] couplings)
+        {
+            Native.Check(Native.pose_set_fem_soft_couplings(Handle, couplings, (UIntPtr)couplings.Length,
+                                                            (UIntPtr)Marshal.SizeOf(typeof(FemSoftCoupling))));
+        }
+
+        /// <summary>How many of the state's soft-soft couplings are in effect (every end moved freely).</summary>
+        public int FemSoftCouplingCount { get { return (int)Native.pose_fem_soft_coupling_count(Handle); } }
 
         /// <summary>The tet mesh's vertices after Apply or Step, copied (the nodes couplings name).</summary>
         public float[] TetPositions()

@@ -20,6 +20,7 @@ mono "$tmp/sample.exe" "$1" "$tmp/csharp.bin" "${@:2}" | tee "$tmp/sample.log"
 grep -q "format 1; .* bent" "$tmp/sample.log"
 grep -Eq "^dynamics: (6 steps, 0\.0500 s simulated, [1-9][0-9]* islands|unsupported)" "$tmp/sample.log"
 grep -Eq "^(couplings: 8 of [0-9]+ nodes near .*, 8 in effect, 0 after removal|dynamics: unsupported)" "$tmp/sample.log"
+grep -Eq "^(soft couplings: 1 in effect, 0 after removal|dynamics: unsupported)" "$tmp/sample.log"
 "$helper" "$1" "$tmp/c.bin" "${@:2}"
 cmp "$tmp/csharp.bin" "$tmp/c.bin"
 if mono "$tmp/sample.exe" "$tmp/missing.rig" "$tmp/x.bin" 2>"$tmp/err.log"; then

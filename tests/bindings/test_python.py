@@ -148,6 +148,20 @@ class Bindings(unittest.TestCase):
             self.assertEqual(state.fem_coupling_count(), 0)
             self.assertIsInstance(rig.fem_couplings(), list)
 
+            # soft-soft couplings: node pairs and a point of three nodes, then removed
+            soft = [(nodes[0], [nodes[1]], [1.0], 50.0), (nodes[2], [nodes[3], nodes[4]], [0.5, 0.5], 50.0)]
+            state.set_fem_soft_couplings(soft)
+            self.assertEqual(state.fem_soft_coupling_count(), 2)
+            with self.assertRaises(pose.PoseError) as caught:
+                state.set_fem_soft_couplings([(nodes[0], [nodes[1]], [0.5], 50.0)])  # weights sum to 0.5
+            self.assertEqual(caught.exception.status, pose.Status.INVALID_ARGUMENT)
+            self.assertEqual(state.fem_soft_coupling_count(), 2)
+            state.step(1 / 120)
+            self.assertGreater(state.dynamics_stats()["islands"], 0)
+            state.set_fem_soft_couplings([])
+            self.assertEqual(state.fem_soft_coupling_count(), 0)
+            self.assertIsInstance(rig.fem_soft_couplings(), list)
+
     @unittest.skipUnless(CLIP, "no clip given (the bridge is not built)")
     def test_bridge_plays_the_clip(self):
         with pose.Rig(RIG) as rig, pose.State(rig) as state, \

@@ -111,6 +111,15 @@ class Sample
         Console.WriteLine("couplings: {0} of {1} nodes near {2} tied, {3} in effect, {4} after removal; "
                           + "the rig has {5}", tied.Length, nodes.Length, rig.Joint(joint).Name, count,
                           state.FemCouplingCount, rig.FemCouplings().Length);
-        return count == tied.Length && state.FemCouplingCount == 0;
+        if (count != tied.Length || state.FemCouplingCount != 0 || nodes.Length < 2)
+            return false;
+        // Soft-soft: the first two of those nodes tied to each other, read back, removed.
+        state.SetFemSoftCouplings(new[] { Pose.FemSoftCoupling.Pair(nodes[0], nodes[1], 50) });
+        int soft = state.FemSoftCouplingCount;
+        state.Step(1.0 / 120);
+        state.SetFemSoftCouplings(new Pose.FemSoftCoupling[0]);
+        Console.WriteLine("soft couplings: {0} in effect, {1} after removal; the rig has {2}", soft,
+                          state.FemSoftCouplingCount, rig.FemSoftCouplings().Length);
+        return soft == 1 && state.FemSoftCouplingCount == 0;
     }
 }

@@ -12,7 +12,7 @@ import ctypes.util
 import os
 
 from ._types import (BridgeFrame, BridgeOptions, BridgeStatus, DynamicsOptions, DynamicsStats, FemCoupling,
-                     FemStats, JointClinical, JointInfo, LoadOptions, StateOptions, TissueInfo, TetInfo, Transform)
+                     FemSoftCoupling, FemStats, JointClinical, JointInfo, LoadOptions, StateOptions, TissueInfo, TetInfo, Transform)
 
 _here = os.path.dirname(os.path.abspath(__file__))
 
@@ -112,6 +112,9 @@ _declare(libpose, [
     ("pose_rig_fem_nodes_near_joint", _status, [_rig, _int, ctypes.c_float, P(ctypes.c_uint32), _size, P(_size)]),
     ("pose_set_fem_couplings", _status, [_state, P(FemCoupling), _size, _size]),
     ("pose_fem_coupling_count", _size, [_state]),
+    ("pose_rig_fem_soft_couplings", _size, [_rig, P(FemSoftCoupling), _size, _size]),
+    ("pose_set_fem_soft_couplings", _status, [_state, P(FemSoftCoupling), _size, _size]),
+    ("pose_fem_soft_coupling_count", _size, [_state]),
 ])
 
 _libbridge = None

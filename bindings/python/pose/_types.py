@@ -98,3 +98,8 @@ class DynamicsStats(ctypes.Structure):
 class FemCoupling(ctypes.Structure):
     _fields_ = [("node", ctypes.c_uint32), ("joint", ctypes.c_int), ("stiffness", ctypes.c_float),
                 ("anchor", _f3)]
+
+
+class FemSoftCoupling(ctypes.Structure):
+    _fields_ = [("node", ctypes.c_uint32), ("other", ctypes.c_uint32 * 4), ("weight", ctypes.c_float * 4),
+                ("stiffness", ctypes.c_float)]

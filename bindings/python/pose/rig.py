@@ -7,7 +7,7 @@ import os
 
 from . import _views
 from ._lib import c_float3, libpose
-from ._types import FemCoupling, JointClinical, JointInfo, LoadOptions, TissueInfo
+from ._types import FemCoupling, FemSoftCoupling, JointClinical, JointInfo, LoadOptions, TissueInfo
 from .errors import PoseError, Status, check
 
 
@@ -153,6 +153,15 @@ class Rig:
         out = (FemCoupling * n)()
         libpose.pose_rig_fem_couplings(self.handle, out, n)
         return [(c.node, c.joint, c.stiffness, tuple(c.anchor)) for c in out]
+
+    def fem_soft_couplings(self):
+        """The rig's soft-soft couplings (its `soft_couplings` section) as (node, others, weights,
+        stiffness) tuples, others and weights 4 each."""
+        size = ctypes.sizeof(FemSoftCoupling)
+        n = libpose.pose_rig_fem_soft_couplings(self.handle, None, 0, size)
+        out = (FemSoftCoupling * n)()
+        libpose.pose_rig_fem_soft_couplings(self.handle, out, n, size)
+        return [(c.node, tuple(c.other), tuple(c.weight), c.stiffness) for c in out]
 
     @property
     def metadata(self):

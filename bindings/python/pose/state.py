@@ -5,7 +5,7 @@ import enum
 
 from . import _views
 from ._lib import c_float3, c_float4, libpose
-from ._types import DynamicsOptions, DynamicsStats, FemCoupling, FemStats, StateOptions, Transform
+from ._types import DynamicsOptions, DynamicsStats, FemCoupling, FemSoftCoupling, FemStats, StateOptions, Transform
 from .errors import PoseError, Status, check
 
 
@@ -153,6 +153,23 @@ class State:
     def fem_coupling_count(self):
         """How many of the state's couplings are in effect (on nodes the simulation moves)."""
         return libpose.pose_fem_coupling_count(self.handle)
+
+    def set_fem_soft_couplings(self, couplings):
+        """Replace the state's soft-soft couplings (pose_set_fem_soft_couplings): (node, others,
+        weights, stiffness) tuples, each node tied by a zero-length spring to the point
+        sum(weights[c] * x[others[c]]) (up to 4; a node pair: ([b], [1.0])); [] removes them."""
+        items = list(couplings)
+        array = (FemSoftCoupling * len(items))()
+        for c, (node, others, weights, stiffness) in zip(array, items):
+            c.node, c.stiffness = node, stiffness
+            c.other[:len(others)] = list(others)
+            c.weight[:len(weights)] = list(weights)
+        check(libpose.pose_set_fem_soft_couplings(self.handle, array, len(items),
+                                                  ctypes.sizeof(FemSoftCoupling)))
+
+    def fem_soft_coupling_count(self):
+        """How many of the state's soft-soft couplings are in effect (every end moved freely)."""
+        return libpose.pose_fem_soft_coupling_count(self.handle)
 
     # ---- results (views of the state's memory, rewritten by apply())
     def _tissue_array(self, fn, tissue):
