@@ -66,6 +66,8 @@ int pp_bake_couplings(const pp_template *t, const pp_mesh *bones, const int *bon
         double *bx = box[e];
         for (int a = 0; a < 3; a++)
             bx[a] = INFINITY, bx[3 + a] = -INFINITY;
+        if (ce->joint < 0) /* soft-soft: bake_soft_couplings.c */
+            continue;
         size_t meshes = 0;
         for (size_t b = 0; b < bone_count; b++) {
             if (!entry_has(ce, bones, bone_joint, b))
@@ -97,7 +99,7 @@ int pp_bake_couplings(const pp_template *t, const pp_mesh *bones, const int *bon
         for (size_t e = 0; e < nc; e++) {
             const pp_template_coupling *ce = &t->couplings[e];
             const double reach = 1e-3 * ce->reach_mm, r2 = reach * reach;
-            const double *bx = box[e];
+            const double *bx = box[e]; /* empty for a soft-soft entry */
             if (p[0] < bx[0] || p[1] < bx[1] || p[2] < bx[2] || p[0] > bx[3] || p[1] > bx[4] ||
                 p[2] > bx[5])
                 continue;

@@ -85,6 +85,8 @@ typedef struct bake_state {
     pose_tissue_desc *tissues;
     pose_fem_coupling *couplings;  /* the template's, resolved (NULL: none) */
     size_t coupling_count;
+    pose_fem_soft_coupling *soft_couplings; /* its soft-soft ones (NULL: none) */
+    size_t soft_coupling_count;
 } bake_state;
 
 static void bake_state_free(bake_state *s, const pp_bake_options *o, size_t tissue_count)
@@ -117,6 +119,7 @@ static void bake_state_free(bake_state *s, const pp_bake_options *o, size_t tiss
     free(s->clinical);
     free(s->tissues);
     free(s->couplings);
+    free(s->soft_couplings);
 }
 
 static int load_meshes(const pp_bake_options *o, bake_state *s, pp_bake_report *rep, char *err,
@@ -285,7 +288,7 @@ static int write_rig(const pp_bake_options *o, bake_state *s, pp_bake_report *re
         memcpy(d->limit_min_deg, tj->limit_min_deg, sizeof d->limit_min_deg);
         memcpy(d->limit_max_deg, tj->limit_max_deg, sizeof d->limit_max_deg);
     }
-    char meta[1024], neutral[256] = "", coupled[128] = "";
+    char meta[1024], neutral[256] = "", coupled[128] = "", soft[96] = "";
     int clinical = clinical_desc(rep, s, neutral, sizeof neutral);
     if (clinical < 0)
         return pp_fail(err, n, POSE_ERR_OUT_OF_MEMORY, "out of memory");
@@ -297,13 +300,20 @@ static int write_rig(const pp_bake_options *o, bake_state *s, pp_bake_report *re
         rep->coupled_nodes = s->coupling_count;
         snprintf(coupled, sizeof coupled, "; %zu nodes coupled to bones (%zu template couplings)",
                  s->coupling_count, t->coupling_count);
+        rc = pp_bake_soft_couplings(t, s->tissues, rep->tissue_count, &s->tet, &s->soft_couplings,
+                                    &s->soft_coupling_count, err, n);
+        if (rc < 0)
+            return rc;
+        rep->soft_coupled_nodes = s->soft_coupling_count;
+        if (s->soft_coupling_count)
+            snprintf(soft, sizeof soft, "; %zu soft-soft couplings", s->soft_coupling_count);
     }
     snprintf(meta, sizeof meta,
              "pose-bake %s; template %s (%s); skin %s; %zu bones; voxel %.2f mm; backend %s; "
-             "K %u; %zu tet vertices, %zu tets%s%s",
+             "K %u; %zu tet vertices, %zu tets%s%s%s",
              pose_version_string(), t->name, o->template_path, o->skin_path, o->bone_count,
              (double)rep->voxel_mm, pp_tet_backend_name(o->backend), s->w.influences,
-             s->tet.vertex_count, s->tet.tet_count, neutral, coupled);
+             s->tet.vertex_count, s->tet.tet_count, neutral, coupled, soft);
     /* POSE_FEM simulates the rig's own tets (bone labels rigid): all it
      * needs stored is the soft tissue's material. */
     const pose_fem_material fem = {
@@ -317,7 +327,7 @@ static int write_rig(const pp_bake_options *o, bake_state *s, pp_bake_report *re
                           s->tissues,         meta,          s->clinical,
                           o->no_fem ? NULL : &fem, o->volume_count, o->volumes,
                           s->coupling_count,  s->couplings,
-                          0,                  NULL};
+                          s->soft_coupling_count, s->soft_couplings};
     /* Write beside the target, then rename: a reader never sees half a rig. */
     size_t len = strlen(o->output_path) + 32;
     char *tmp = malloc(len);

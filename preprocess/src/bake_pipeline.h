@@ -98,6 +98,7 @@ typedef struct pp_bake_report {
     pp_cor_report cor;
     size_t soft_bones;             /**< bone files not in the template (kept as soft tissue) */
     size_t coupled_nodes;          /**< simulation nodes the template's couplings tie to bones */
+    size_t soft_coupled_nodes;     /**< springs its soft-soft couplings tie between parts */
     size_t rig_bytes;
 } pp_bake_report;
 
@@ -121,6 +122,19 @@ void pp_bake_report_free(pp_bake_report *r);
 int pp_bake_couplings(const pp_template *t, const pp_mesh *bones, const int *bone_joint,
                       size_t bone_count, const pp_tetmesh *tet, pose_fem_coupling **out,
                       size_t *count, char *err, size_t err_size);
+
+/**
+ * The template's soft-soft "couplings" resolved on the tet mesh
+ * (bake_soft_couplings.c): per entry, every free soft node of the soft tets
+ * that embed `tissue` (and of none that embed `to` or a bone) within
+ * reach_mm of a soft tet that embeds `to`, tied to that tet's nearest point
+ * (corners and barycentric weights); entry after entry, nodes ascending.
+ * *out malloc'd (NULL when none). An entry naming a tissue the bake does
+ * not have is an error naming it.
+ */
+int pp_bake_soft_couplings(const pp_template *t, const pose_tissue_desc *tissues,
+                           size_t tissue_count, const pp_tetmesh *tet,
+                           pose_fem_soft_coupling **out, size_t *count, char *err, size_t err_size);
 
 /** The report as JSON text (cJSON; caller frees with free()), or NULL. */
 char *pp_bake_report_json(const pp_bake_report *r, const pp_bake_options *opt);

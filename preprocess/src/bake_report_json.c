@@ -40,6 +40,7 @@ char *pp_bake_report_json(const pp_bake_report *r, const pp_bake_options *o)
     cJSON_AddNumberToObject(root, "peak_rss_mb", round(r->peak_rss_mb * 10) / 10);
     cJSON_AddNumberToObject(root, "rig_bytes", (double)r->rig_bytes);
     cJSON_AddNumberToObject(root, "coupled_nodes", (double)r->coupled_nodes);
+    cJSON_AddNumberToObject(root, "soft_coupled_nodes", (double)r->soft_coupled_nodes);
     cJSON *st = cJSON_AddObjectToObject(root, "stage_seconds");
     for (int s = 0; s < PP_STAGE_COUNT; s++)
         cJSON_AddNumberToObject(st, pp_bake_stage_name((pp_bake_stage)s),

@@ -462,10 +462,17 @@ static int parse_coupling(const parse_ctx *c, const cJSON *obj, size_t index, pp
                        repeated_key(obj));
     k->joint = -1;
     k->stiffness = PP_COUPLING_STIFFNESS;
-    int have_reach = 0, named = 0;
+    int have_reach = 0, named = 0, soft = 0;
     for (const cJSON *e = obj->child; e; e = e->next) {
         const char *key = e->string;
-        if (strcmp(key, "bone") == 0 || strcmp(key, "joint") == 0) {
+        if (strcmp(key, "tissue") == 0 || strcmp(key, "to") == 0) {
+            soft |= key[1] == 'i' ? 1 : 2;
+            if (!cJSON_IsString(e) || !valid_name(e->valuestring))
+                return fail_at(c, POSE_ERR_FORMAT, NULL,
+                               "couplings[%zu]: '%s' must be a tissue name of 1..63 bytes", index,
+                               key);
+            strcpy(key[1] == 'i' ? k->tissue : k->to, e->valuestring);
+        } else if (strcmp(key, "bone") == 0 || strcmp(key, "joint") == 0) {
             const int bone = key[0] == 'b';
             if (named++)
                 return fail_at(c, POSE_ERR_FORMAT, NULL,
@@ -496,9 +503,29 @@ static int parse_coupling(const parse_ctx *c, const cJSON *obj, size_t index, pp
             k->stiffness = (float)e->valuedouble;
         } else if (strcmp(key, "comment") != 0) {
             return fail_at(c, POSE_ERR_FORMAT, NULL,
-                           "couplings[%zu]: unknown key '%s' (expected bone or joint, reach_mm, "
-                           "stiffness, comment)", index, key);
+                           "couplings[%zu]: unknown key '%s' (expected bone or joint, or tissue and "
+                           "to; reach_mm, stiffness, comment)", index, key);
         }
+    }
+    if (soft) { /* soft-soft: tissue and to, reach at most 10 mm (the spring spans it at rest) */
+        if (named || soft != 3 || !have_reach)
+            return fail_at(c, POSE_ERR_FORMAT, NULL,
+                           "couplings[%zu]: a soft-soft coupling needs 'tissue', 'to' and "
+                           "'reach_mm', and no 'bone' or 'joint'", index);
+        if (strcmp(k->tissue, k->to) == 0)
+            return fail_at(c, POSE_ERR_INVALID_DATA, NULL,
+                           "couplings[%zu]: 'tissue' and 'to' are both '%s'", index, k->to);
+        if (k->reach_mm > 10.0f)
+            return fail_at(c, POSE_ERR_FORMAT, NULL,
+                           "couplings[%zu]: a soft-soft 'reach_mm' must be in (0, 10] (the "
+                           "spring pulls the gap shut)", index);
+        for (size_t i = 0; i < index; i++)
+            if (strcmp(t->couplings[i].tissue, k->tissue) == 0 &&
+                strcmp(t->couplings[i].to, k->to) == 0)
+                return fail_at(c, POSE_ERR_INVALID_DATA, NULL,
+                               "couplings[%zu]: the same tissues '%s' and '%s' as couplings[%zu]",
+                               index, k->tissue, k->to, i);
+        return POSE_OK;
     }
     if (!named || !have_reach)
         return fail_at(c, POSE_ERR_FORMAT, NULL, "couplings[%zu]: needs 'bone' or 'joint', and 'reach_mm'",

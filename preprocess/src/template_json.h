@@ -28,7 +28,11 @@
  *                                           the bone's surface, (0, 100] millimetres
  *       "stiffness": 100,                   optional: multiple of each node's own elastic
  *                                           stiffness, (0, 1e6], default 100
- *       "comment": "..." } ] }
+ *       "comment": "..." },
+ *     { "tissue": "fascia_lata",            or soft-soft: the nodes of one tissue mesh's
+ *       "to": "r_quadriceps",               part of the tet mesh, tied to another's
+ *       "reach_mm": 2,                      within this distance of its tets, (0, 10]
+ *       "stiffness": 100 } ] }
  * Unknown or repeated keys are errors, so typos do not pass silently.
  *
  * "couplings" (Otaduy et al. §4.2, §5.2): pose-bake ties every soft
@@ -37,7 +41,13 @@
  * zero-length spring (the rig's `couplings` section; pose.h
  * pose_fem_coupling): skin over the shin, the sternum, the skull, the
  * iliac crest, the olecranon. A node within reach of several entries takes
- * the nearest bone.
+ * the nearest bone. A soft-soft entry ties the free soft nodes of the tets
+ * that embed "tissue" (not nodes of those that embed "to") lying within
+ * reach of a tet that embeds "to" to that tet's nearest point (the rig's
+ * `soft_couplings` section; pose.h pose_fem_soft_coupling): where two
+ * parts meshed apart touch; the spring spans the gap at rest (zero where
+ * the node lies in the tet), so the reach is small. Tissue names are the
+ * bake's mesh names, checked when baking.
  *
  * "clinical" describes the joint's clinical angles (design §2b, pose.h
  * pose_joint_clinical) in model space, in the anatomical neutral posture:
@@ -122,11 +132,13 @@ typedef struct pp_template_joint {
     pp_template_clinical clinical;
 } pp_template_joint;
 
-/** A "couplings" entry. */
+/** A "couplings" entry: to a bone (joint >= 0), or soft-soft (tissue and to). */
 typedef struct pp_template_coupling {
     char bone[PP_NAME_MAX];     /**< a bone mesh, or "" for every bone of the joint */
-    int joint;                  /**< the joint whose rigid motion the nodes follow */
-    float reach_mm;             /**< (0, 100] */
+    int joint;                  /**< the joint whose rigid motion the nodes follow; -1: soft-soft */
+    char tissue[PP_NAME_MAX];   /**< soft-soft: the tissue mesh whose nodes are tied ("" else) */
+    char to[PP_NAME_MAX];       /**< soft-soft: the tissue mesh they are tied to */
+    float reach_mm;             /**< (0, 100]; soft-soft (0, 10] */
     float stiffness;            /**< (0, 1e6]: multiple of a node's own elastic stiffness */
 } pp_template_coupling;
 

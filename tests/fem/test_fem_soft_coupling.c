@@ -163,7 +163,7 @@ static void test_force_is_energy_gradient(void **state)
     float x[21], out[21], out2[21];
     srand(7);
     for (int i = 0; i < 21; i++)
-        x[i] = (float)rand() / RAND_MAX - 0.5f;
+        x[i] = (float)((double)rand() / RAND_MAX - 0.5);
     for (int s = 0; s < 2; s++) {
         const pose__fem_links l = {.count = 1, .node = node + s, .corner = corner + 4 * s,
                                    .weight = weight + 4 * s, .k = k + s, .touched_count = 7,

@@ -20,10 +20,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 if (pp_template_joint_of_bone(&t, t.joints[i].bones[b]) != (int)i)
                     __builtin_trap();
         }
-        for (size_t i = 0; i < t.coupling_count; i++) /* couplings name known joints */
-            if (t.couplings[i].joint < 0 || (size_t)t.couplings[i].joint >= t.joint_count ||
-                !(t.couplings[i].reach_mm > 0.0f && t.couplings[i].stiffness > 0.0f))
+        for (size_t i = 0; i < t.coupling_count; i++) { /* couplings name known joints, or
+                                                           two different tissues */
+            const pp_template_coupling *c = &t.couplings[i];
+            const int soft = c->joint < 0;
+            if ((soft ? !c->tissue[0] || !c->to[0] || strcmp(c->tissue, c->to) == 0 ||
+                            c->reach_mm > 10.0f
+                      : (size_t)c->joint >= t.joint_count || c->tissue[0] || c->to[0]) ||
+                !(c->reach_mm > 0.0f && c->stiffness > 0.0f))
                 __builtin_trap();
+        }
     } else if (err[0] == '\0' || !strstr(err, "fuzz.json")) {
         __builtin_trap(); /* every failure names the source */
     }

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bake_pipeline.h"
 #include "template_json.h"
 
 #define HEAD "{\"format\": \"pose-skeleton-template\", \"version\": 1, \"joints\": [\n"
@@ -154,6 +155,19 @@ static void test_rejects_malformed(void **state)
         {KNEE "{\"bone\": \"tibia\", \"reach_mm\": 8}, {\"bone\": \"tibia\", \"reach_mm\": 3}]}",
          POSE_ERR_INVALID_DATA, "couplings[1]: the same bone 'tibia' as couplings[0]"},
         {KNEE "7]}", POSE_ERR_FORMAT, "couplings[0] must be an object"},
+        {KNEE "{\"tissue\": \"fascia\", \"reach_mm\": 2}]}", POSE_ERR_FORMAT,
+         "couplings[0]: a soft-soft coupling needs 'tissue', 'to' and 'reach_mm'"},
+        {KNEE "{\"tissue\": \"fascia\", \"to\": \"muscle\", \"bone\": \"tibia\", \"reach_mm\": 2}]}",
+         POSE_ERR_FORMAT, "couplings[0]: a soft-soft coupling needs"},
+        {KNEE "{\"tissue\": \"fascia\", \"to\": \"fascia\", \"reach_mm\": 2}]}",
+         POSE_ERR_INVALID_DATA, "couplings[0]: 'tissue' and 'to' are both 'fascia'"},
+        {KNEE "{\"tissue\": \"fascia\", \"to\": \"muscle\", \"reach_mm\": 12}]}", POSE_ERR_FORMAT,
+         "couplings[0]: a soft-soft 'reach_mm' must be in (0, 10]"},
+        {KNEE "{\"tissue\": \"fascia\", \"to\": 3, \"reach_mm\": 2}]}", POSE_ERR_FORMAT,
+         "couplings[0]: 'to' must be a tissue name of 1..63 bytes"},
+        {KNEE "{\"tissue\": \"a\", \"to\": \"b\", \"reach_mm\": 2},\n"
+              "{\"to\": \"b\", \"tissue\": \"a\", \"reach_mm\": 1}]}",
+         POSE_ERR_INVALID_DATA, "couplings[1]: the same tissues 'a' and 'b' as couplings[0]"},
         {HEAD ROOT "], \"couplings\": {}}", POSE_ERR_FORMAT, "'couplings' must be an array"},
         {HEAD "{\"name\": \"0123456789012345678901234567890123456789012345678901234567890123\", "
               "\"rule\": \"root\", \"bones\": [\"p\"]}]}",
@@ -194,12 +208,100 @@ static void test_reads_couplings(void **state)
     assert_int_equal(t.couplings[2].joint, 0);
     assert_true(t.couplings[2].stiffness == 1e6f);
     pp_template_free(&t);
+    /* the soft-soft form: two tissues, beside couplings to bones */
+    const char *soft = KNEE "{\"bone\": \"tibia\", \"reach_mm\": 12.5},\n"
+                            "{\"tissue\": \"fascia\", \"to\": \"muscle\", \"reach_mm\": 2, "
+                            "\"stiffness\": 50}]}";
+    if (pp_template_parse(soft, strlen(soft), "t.json", &t, err, sizeof err) != POSE_OK)
+        fail_msg("%s", err);
+    assert_int_equal(t.coupling_count, 2);
+    assert_string_equal(t.couplings[0].tissue, "");
+    assert_int_equal(t.couplings[1].joint, -1);
+    assert_string_equal(t.couplings[1].tissue, "fascia");
+    assert_string_equal(t.couplings[1].to, "muscle");
+    assert_true(t.couplings[1].reach_mm == 2.0f && t.couplings[1].stiffness == 50.0f);
+    pp_template_free(&t);
     assert_int_equal(t.coupling_count, 0);
     /* an empty array: no couplings */
     const char *none = KNEE "]}";
     assert_int_equal(pp_template_parse(none, strlen(none), "t.json", &t, err, sizeof err), POSE_OK);
     assert_int_equal(t.coupling_count, 0);
     pp_template_free(&t);
+}
+
+/* pp_bake_soft_couplings on two cubes of 6 tets, 1 cm, meshed apart: B's
+ * beside A at x = 1 cm (its face nodes on A's), then 0.5 mm beyond it. A's
+ * free face nodes within reach of B's tets are tied to their nearest point
+ * (one corner of weight 1 when they touch), the others not; a tissue the
+ * bake does not have is named. */
+static void test_resolves_soft_couplings(void **state)
+{
+    (void)state;
+    static const int path[6][2] = {{1, 3}, {1, 5}, {2, 3}, {2, 6}, {4, 5}, {4, 6}};
+    float pos[16 * 3];
+    uint32_t tets[12 * 4], emb[12];
+    uint16_t labels[12] = {0};
+    for (int gap = 0; gap < 2; gap++) {
+        for (int c = 0; c < 16; c++) {
+            const int cube = c / 8, k = c % 8;
+            pos[3 * c] = 0.01f * (float)(cube + (k & 1)) + (cube && gap ? 5e-4f : 0.0f);
+            pos[3 * c + 1] = 0.01f * (float)((k >> 1) & 1);
+            pos[3 * c + 2] = 0.01f * (float)((k >> 2) & 1);
+        }
+        for (int t = 0; t < 12; t++) {
+            const uint32_t o = t < 6 ? 0 : 8;
+            const uint32_t v[4] = {o, o + (uint32_t)path[t % 6][0], o + (uint32_t)path[t % 6][1],
+                                   o + 7};
+            memcpy(tets + 4 * t, v, sizeof v);
+            emb[t] = (uint32_t)t;
+        }
+        const pp_tetmesh mesh = {16, pos, 12, tets, labels};
+        /* tissue a: a vertex in each of A's tets; b: in each of B's */
+        const pose_tissue_desc tissues[2] = {{.name = "a", .vertex_count = 6, .tet = emb},
+                                             {.name = "b", .vertex_count = 6, .tet = emb + 6}};
+        const char *text = KNEE "{\"tissue\": \"a\", \"to\": \"b\", \"reach_mm\": 1}]}";
+        pp_template t;
+        char err[512];
+        if (pp_template_parse(text, strlen(text), "t.json", &t, err, sizeof err) != POSE_OK)
+            fail_msg("%s", err);
+        pose_fem_soft_coupling *c = NULL;
+        size_t n = 0;
+        assert_int_equal(pp_bake_soft_couplings(&t, tissues, 2, &mesh, &c, &n, err, sizeof err),
+                         POSE_OK);
+        assert_int_equal(n, 4); /* A's face x = 1 cm: corners 1, 3, 5, 7 */
+        for (size_t i = 0; i < n; i++) {
+            assert_true(c[i].node % 2 == 1 && c[i].node < 8);
+            double p[3] = {0, 0, 0}, d2 = 0.0, sum = 0.0;
+            for (int k = 0; k < 4; k++) {
+                sum += c[i].weight[k];
+                for (int a = 0; a < 3; a++)
+                    p[a] += c[i].weight[k] * pos[3 * c[i].other[k] + (uint32_t)a];
+            }
+            for (int a = 0; a < 3; a++)
+                d2 += pow(p[a] - pos[3 * c[i].node + (uint32_t)a], 2);
+            assert_true(fabs(sum - 1.0) < 1e-6);
+            /* touching: B's own corner; apart: its face, 0.5 mm away */
+            assert_true(fabs(sqrt(d2) - (gap ? 5e-4 : 0.0)) < 1e-6);
+            assert_true(c[i].stiffness == 100.0f);
+        }
+        free(c);
+        pp_template_free(&t);
+        const char *far = KNEE "{\"tissue\": \"a\", \"to\": \"b\", \"reach_mm\": 0.4}]}";
+        assert_int_equal(pp_template_parse(far, strlen(far), "t.json", &t, err, sizeof err), POSE_OK);
+        assert_int_equal(pp_bake_soft_couplings(&t, tissues, 2, &mesh, &c, &n, err, sizeof err),
+                         POSE_OK);
+        assert_int_equal(n, gap ? 0 : 4);
+        free(c);
+        pp_template_free(&t);
+        const char *missing = KNEE "{\"tissue\": \"a\", \"to\": \"c\", \"reach_mm\": 1}]}";
+        assert_int_equal(pp_template_parse(missing, strlen(missing), "t.json", &t, err, sizeof err),
+                         POSE_OK);
+        assert_int_equal(pp_bake_soft_couplings(&t, tissues, 2, &mesh, &c, &n, err, sizeof err),
+                         POSE_ERR_INVALID_ARGUMENT);
+        assert_non_null(strstr(err, "couplings[0] names tissue 'c', but the bake has no such mesh"));
+        assert_null(c);
+        pp_template_free(&t);
+    }
 }
 
 static void test_missing_file(void **state)
@@ -314,6 +416,7 @@ int main(void)
         cmocka_unit_test(test_reads_minimal),
         cmocka_unit_test(test_reads_clinical),
         cmocka_unit_test(test_reads_couplings),
+        cmocka_unit_test(test_resolves_soft_couplings),
         cmocka_unit_test(test_full_body_template),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
