@@ -554,7 +554,9 @@ static void vertices_pass(solve_ctx *c, size_t chunk)
             pose__fem_gather(m, w->corner, v, f);
             for (int a = 0; a < 3; a++) {
                 p[a] = z[a] + c->beta * p[a];
-                ap[a] = id > 0.0f ? f[a] + ks * p[a] + (lo ? lo[a] : 0.0f) : 0.0f;
+                ap[a] = id > 0.0f ? f[a] + ks * p[a] : 0.0f;
+                if (lo)
+                    ap[a] += lo[a];
                 s0 += (double)p[a] * ap[a];
                 s2 += (double)p[a] * gv[a];
             }
