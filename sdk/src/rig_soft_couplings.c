@@ -12,12 +12,11 @@
 #include "rig_io.h"
 #include "rig_runtime.h"
 
+#define SAME_FIELD(f) (offsetof(pose_fem_soft_coupling, f) == offsetof(pose__soft_coupling_record, f))
 _Static_assert(sizeof(pose_fem_soft_coupling) == sizeof(pose__soft_coupling_record) &&
-                   offsetof(pose_fem_soft_coupling, other) == offsetof(pose__soft_coupling_record, other) &&
-                   offsetof(pose_fem_soft_coupling, weight) == offsetof(pose__soft_coupling_record, weight) &&
-                   offsetof(pose_fem_soft_coupling, stiffness) ==
-                       offsetof(pose__soft_coupling_record, stiffness),
+                   SAME_FIELD(other) && SAME_FIELD(weight) && SAME_FIELD(stiffness),
                "the record is pose_fem_soft_coupling of 0.2");
+#undef SAME_FIELD
 
 int pose__soft_coupling_fault(const pose__soft_coupling_record *r, size_t nv, char *why, size_t cap,
                               size_t *at)

@@ -79,9 +79,8 @@ static int setup(void **state)
             for (size_t q = p + 1; q < k && !found; q++) {
                 const uint32_t b = nb[p], c = nb[q];
                 double off = 0.0;
-                for (int e = 0; e < 3; e++)
-                    off = fmax(off, fabs(0.5 * ((double)x[3 * b + (size_t)e] + x[3 * c + (size_t)e]) -
-                                         x[3 * a + (size_t)e]));
+                for (size_t e = 0; e < 3; e++)
+                    off = fmax(off, fabs(0.5 * ((double)x[3 * b + e] + x[3 * c + e]) - x[3 * a + e]));
                 if (b != c && off < 1e-6) {
                     g_soft[g_soft_count++] = (pose_fem_soft_coupling){
                         .node = a, .other = {b, c}, .weight = {0.5f, 0.5f}, .stiffness = 100.0f};
@@ -125,7 +124,8 @@ static double tie_gap(const pose_state *st)
         const pose_fem_soft_coupling *c = &g_soft[i];
         double d2 = 0.0;
         for (int e = 0; e < 3; e++) {
-            const double p = 0.5 * ((double)x[3 * c->other[0] + (size_t)e] + x[3 * c->other[1] + (size_t)e]);
+            const double p =
+                0.5 * ((double)x[3 * c->other[0] + (size_t)e] + x[3 * c->other[1] + (size_t)e]);
             d2 += pow(x[3 * c->node + (size_t)e] - p, 2);
         }
         worst = fmax(worst, sqrt(d2));
