@@ -379,50 +379,56 @@ static pose_status map_fem(const pose__source *src, const entry *s, pose_rig *ri
     return POSE_OK;
 }
 
-/* Coupling records (count in the header); their values are checked by
- * rig_couplings.c. */
-static pose_status map_couplings(const pose__source *src, const entry *s, pose_rig *rig)
+/* A section of `count` records after its header (the count in its first
+ * 4 bytes, the rest zero; a section with none is not written): the records
+ * and their count; their values are checked by the section's own file. */
+static pose_status map_counted(const pose__source *src, const entry *s, const char *name,
+                               const char *records, uint64_t (*size_of)(uint64_t),
+                               const uint8_t **first, uint32_t *count)
 {
     const uint8_t *p = src->base + s->offset;
     pose_status st = need_header(src, s);
     if (st != POSE_OK)
         return st;
-    uint32_t count = get_u32(p);
-    if (count == 0)
-        return pose__source_fail(src, POSE_ERR_FORMAT, "couplings", p,
-                                 "0 couplings (a rig without couplings has no section)");
+    const uint32_t n = get_u32(p);
+    if (n == 0)
+        return pose__source_fail(src, POSE_ERR_FORMAT, name, p,
+                                 "0 %s (a rig without them has no section)", records);
     if (!all_zero(p + 4, POSE__RIG_SECTION_HEADER - 4))
-        return pose__source_fail(src, POSE_ERR_FORMAT, "couplings", p + 4,
+        return pose__source_fail(src, POSE_ERR_FORMAT, name, p + 4,
                                  "reserved header bytes are not zero");
-    if (s->size != pose__couplings_size_of(count))
-        return size_mismatch(src, s, pose__couplings_size_of(count), "its coupling count");
-    rig->couplings = (const pose__coupling_record *)(const void *)(p + POSE__RIG_SECTION_HEADER);
-    rig->coupling_count = count;
+    if (s->size != size_of(n))
+        return size_mismatch(src, s, size_of(n), "its record count");
+    *first = p + POSE__RIG_SECTION_HEADER;
+    *count = n;
     return POSE_OK;
 }
 
-/* Soft coupling records (count in the header); their values are checked
- * by rig_soft_couplings.c. */
+/* Coupling records (rig_couplings.c). */
+static pose_status map_couplings(const pose__source *src, const entry *s, pose_rig *rig)
+{
+    const uint8_t *first;
+    uint32_t count;
+    pose_status st = map_counted(src, s, "couplings", "couplings", pose__couplings_size_of, &first, &count);
+    if (st == POSE_OK) {
+        rig->couplings = (const pose__coupling_record *)(const void *)first;
+        rig->coupling_count = count;
+    }
+    return st;
+}
+
+/* Soft coupling records (rig_soft_couplings.c). */
 static pose_status map_soft_couplings(const pose__source *src, const entry *s, pose_rig *rig)
 {
-    const uint8_t *p = src->base + s->offset;
-    pose_status st = need_header(src, s);
-    if (st != POSE_OK)
-        return st;
-    uint32_t count = get_u32(p);
-    if (count == 0)
-        return pose__source_fail(src, POSE_ERR_FORMAT, "soft_couplings", p,
-                                 "0 soft couplings (a rig without them has no section)");
-    if (!all_zero(p + 4, POSE__RIG_SECTION_HEADER - 4))
-        return pose__source_fail(src, POSE_ERR_FORMAT, "soft_couplings", p + 4,
-                                 "reserved header bytes are not zero");
-    if (s->size != pose__soft_couplings_size_of(count))
-        return size_mismatch(src, s, pose__soft_couplings_size_of(count),
-                             "its soft coupling count");
-    rig->soft_couplings =
-        (const pose__soft_coupling_record *)(const void *)(p + POSE__RIG_SECTION_HEADER);
-    rig->soft_coupling_count = count;
-    return POSE_OK;
+    const uint8_t *first;
+    uint32_t count;
+    pose_status st = map_counted(src, s, "soft_couplings", "soft couplings",
+                                 pose__soft_couplings_size_of, &first, &count);
+    if (st == POSE_OK) {
+        rig->soft_couplings = (const pose__soft_coupling_record *)(const void *)first;
+        rig->soft_coupling_count = count;
+    }
+    return st;
 }
 
 /* Tissue records hold counts and offsets; the offsets must follow the one
