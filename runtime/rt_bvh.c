@@ -26,21 +26,26 @@ void pose__bvh_refit_leaves(pose__bvh *t, const float *positions, size_t begin, 
 {
     for (size_t l = begin; l < end; l++) {
         pose__bvh_node *n = &t->nodes[t->leaves[l]];
-        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        /* the axes written out: the loops over them were not unrolled */
+        float lx = INFINITY, ly = INFINITY, lz = INFINITY, hx = -INFINITY, hy = -INFINITY, hz = -INFINITY;
         for (uint32_t i = n->first; i < n->first + n->count; i++) {
             const uint32_t *tri = t->triangles + 3 * (size_t)t->items[i];
             for (int k = 0; k < 3; k++) {
                 const float *x = vertex(positions, tri[k]);
-                for (int d = 0; d < 3; d++) {
-                    lo[d] = min2(lo[d], x[d]);
-                    hi[d] = max2(hi[d], x[d]);
-                }
+                lx = min2(lx, x[0]);
+                ly = min2(ly, x[1]);
+                lz = min2(lz, x[2]);
+                hx = max2(hx, x[0]);
+                hy = max2(hy, x[1]);
+                hz = max2(hz, x[2]);
             }
         }
-        for (int d = 0; d < 3; d++) {
-            n->lo[d] = lo[d];
-            n->hi[d] = hi[d];
-        }
+        n->lo[0] = lx;
+        n->lo[1] = ly;
+        n->lo[2] = lz;
+        n->hi[0] = hx;
+        n->hi[1] = hy;
+        n->hi[2] = hz;
     }
 }
 
