@@ -76,4 +76,7 @@ typedef struct pose__bvh_near {
 float pose__bvh_nearest(const pose__bvh *t, const float *positions, const float *p, float max_dist,
                         pose__bvh_near *out);
 
+/** Squared distance from p to triangle abc. rt_bvh_nearest.c. */
+float pose__point_tri_dist2(const float *p, const float *a, const float *b, const float *c);
+
 #endif /* POSE_RT_BVH_H */

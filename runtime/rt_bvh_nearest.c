@@ -53,6 +53,14 @@ static void closest_on_tri(const float *p, const float *a, const float *b, const
         out[d] = a[d] + s * ab[d] + t * ac[d];
 }
 
+float pose__point_tri_dist2(const float *p, const float *a, const float *b, const float *c)
+{
+    float q[3];
+    int feature;
+    closest_on_tri(p, a, b, c, q, &feature);
+    return (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) + (q[2] - p[2]) * (q[2] - p[2]);
+}
+
 static float box_dist2(const pose__bvh_node *n, const float *p)
 {
     float s = 0.0f;

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "alloc.h"
+#include "contact_cover.h"
 #include "error.h"
 #include "rt_quat.h"
 #include "state_internal.h"
@@ -275,9 +276,16 @@ void pose__state_push_item(void *ctx, size_t item)
                 for (size_t i = gb; i < ge; i++) {
                     if (p->skip[i] || done[i - vb] || p->own_joint[i] == b->joint)
                         continue;
-                    const float m = push_vertex(p, b, f, st->tissue_positions + 3 * (size_t)p->order[i], &p->cache[i]);
+                    float *x = st->tissue_positions + 3 * (size_t)p->order[i], before[3];
+                    memcpy(before, x, sizeof before);
+                    float m = push_vertex(p, b, f, x, &p->cache[i]);
                     done[i - vb] = m > 0.0f;
-                    pushed += m > 0.0f;
+                    if (m > 0.0f) {
+                        /* lifted first: counted by the cover, its whole move here */
+                        const float whole = pose__cover_bound(p, b, f, i, before, x);
+                        pushed += !(whole >= 0.0f);
+                        m = whole >= 0.0f ? whole : m;
+                    }
                     most = m > most ? m : most;
                 }
             }
@@ -287,7 +295,9 @@ void pose__state_push_item(void *ctx, size_t item)
     p->max_push[item] = most;
 }
 
-void pose__state_push(pose_state *st)
+/* The response's pass: the bones' frames, then (pose_apply) the cover's
+ * lifts, then the push, item by item. */
+static void push_pass(pose_state *st, int cover)
 {
     if (!st->push || !st->push_enabled)
         return;
@@ -295,8 +305,24 @@ void pose__state_push(pose_state *st)
     memset(st->push->pushed, 0, sizeof st->push->pushed);
     memset(st->push->max_push, 0, sizeof st->push->max_push);
     pose__state_push_frames(st);
+    pose__cover *c = st->push->cover;
+    c->moved = 0;
+    c->max_move = 0.0f;
+    if (cover)
+        pose__state_cover(st); /* contact_cover.c: skin lifted over bone that came out through it */
     pose__pool_run_items(st->pool, pose__state_push_item, st, POSE__PUSH_ITEMS);
+    pose__cover_finish(c);
     st->push_seconds = pose__seconds() - t0;
+}
+
+void pose__state_push(pose_state *st)
+{
+    push_pass(st, 0);
+}
+
+void pose__state_push_cover(pose_state *st)
+{
+    push_pass(st, 1);
 }
 
 void pose__state_push_free(pose_state *st)
@@ -361,6 +387,9 @@ pose_status pose_get_contact_response_stats(const pose_state *st, pose_contact_r
             out->pushed += st->push->pushed[k];
             out->max_push = st->push->max_push[k] > out->max_push ? st->push->max_push[k] : out->max_push;
         }
+        const pose__cover *c = st->push->cover;
+        out->pushed += c->moved;
+        out->max_push = c->max_move > out->max_push ? c->max_move : out->max_push;
         out->seconds = st->push_seconds;
     }
     return POSE_OK;

@@ -100,6 +100,7 @@ typedef struct pose__push {
     float *bone_spheres;    /**< per bone per frame: posed centre and radius */
     size_t pushed[POSE__PUSH_ITEMS]; /**< per item of the last pass */
     float max_push[POSE__PUSH_ITEMS];
+    struct pose__cover *cover; /**< skin lifted over bone before the push (contact_cover.h) */
     double build_seconds;
     /* The dynamic response (contact_dyn.c): the tet mesh's soft nodes,
      * built by the first pose_step with the response on. */
@@ -174,9 +175,12 @@ void pose__state_contact_rests(struct pose_state *st, float dt, struct pose__fem
  *  of a bone); the counts into the push's per-item arrays. */
 void pose__state_contact_step(struct pose_state *st, float dt);
 
-/** pose_apply's last pass when the response is on: the bones' frames for
+/** pose_step's last pass when the response is on: the bones' frames for
  *  the pose (serial, cheap), then the skin pushed, item by item. */
 void pose__state_push(struct pose_state *st);
+/** pose_apply's: as pose__state_push, with the skin first lifted over bone
+ *  that came out through it (contact_cover.h). */
+void pose__state_push_cover(struct pose_state *st);
 void pose__state_push_frames(struct pose_state *st);
 void pose__state_push_item(void *ctx, size_t item);
 /** pose_state_free: what pose_set_contact_response built. */

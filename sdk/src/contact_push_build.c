@@ -7,6 +7,7 @@
 
 #include "alloc.h"
 #include "contact_build.h"
+#include "contact_cover.h"
 #include "contact_push.h"
 #include "error.h"
 #include "state_internal.h"
@@ -535,6 +536,9 @@ void pose__push_release(pose__push *p)
     pose__free(a, p->rest_on);
     pose__free(a, p->rest_stiff);
     pose__free(a, p->rest_force);
+    if (p->cover)
+        pose__cover_release(p->cover, a);
+    pose__free(a, p->cover);
     const pose_allocator keep = *a;
     memset(p, 0, sizeof *p);
     p->allocator = keep;
@@ -574,6 +578,11 @@ pose_status pose__push_build(pose__push *p, const pose_state *st, float margin)
         return s;
     mark_rest_inside(p, st);
     if ((s = mark_rigid(p, st)) != POSE_OK)
+        return s;
+    p->cover = pose__calloc(&p->allocator, sizeof *p->cover, POSE__ALIGN);
+    if (!p->cover)
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for the contact cover");
+    if ((s = pose__cover_build(p->cover, st, p)) != POSE_OK)
         return s;
     p->build_seconds = pose__seconds() - t0;
     return POSE_OK;

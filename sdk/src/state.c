@@ -322,7 +322,7 @@ pose_status pose_apply(pose_state *st)
     pose__state_transfer_pass(st);
     if (st->method == POSE_FEM)
         st->fem_stats.seconds_transfer = pose__seconds() - t0;
-    pose__state_push(st); /* contact_push.c: skin out of bone, on the final positions */
+    pose__state_push_cover(st); /* contact_push.c: skin over and out of bone, on the final positions */
     return POSE_OK;
 }
 

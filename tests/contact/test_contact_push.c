@@ -2,11 +2,12 @@
 /* pose_set_contact_response on the body baked from data/anatomy (coarse,
  * tests/binding's bake) at issue 13's poses, LBS and DQS: skin vertices in
  * bone and bone vertices out of the skin (pose_contact_detect) with the
- * response off and on; no skin vertex moves by more than its depth in bone
- * (distance to the nearest posed bone triangle) plus 1 mm; 1 and 2 threads
- * give the same skin bit for bit; the pass's time. Skin in bone at rest
- * (the orbits and the mouth) is anatomy, left alone and counted apart. A
- * rig path is taken from POSE_CONTACT_RIG. */
+ * response off and on, each to fall by 95 %; no skin vertex moves by more
+ * than its depth (in bone, or of the bone that comes out through its own
+ * triangles: cover_depth) plus 1 mm; 1 and 2 threads give the same skin bit
+ * for bit; the pass's time. Skin in bone at rest (the orbits and the mouth)
+ * is anatomy, left alone and counted apart. A rig path is taken from
+ * POSE_CONTACT_RIG. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -25,23 +26,20 @@
 #include "tri_distance.h"
 
 /* The acceptance's bound on a move beyond the depth, and the falls this
- * test holds the response to. The issue asks 0.95 for both; skin in bone
- * falls by 0.977 here (LBS and DQS, the four poses). Bone out of skin is
- * counted, as skin in bone is, without the vertices out at rest (2011 of
- * them: skull, jaw, scapulae; data/anatomy/README.md): 710 over the eight
- * runs, 677 with the response (4.6 %), since covering bone needs the skin
- * pushed outward over it, which this response does not do yet: held to
- * "not worse". A move is bounded by the skin vertex's depth in bone or, for
- * one lifted over bone, by the protrusion of the bone vertices newly out
- * of the skin near it (poke_depth). */
+ * test holds the response to (the issue asks 0.95 for both). Skin in bone
+ * and bone out of skin are counted without what is so at rest (123 skin
+ * vertices in the orbits and the mouth, 2011 bone vertices of the skull,
+ * jaw and scapulae; data/anatomy/README.md). A skin vertex's depth is the
+ * larger of its depth in bone and the protrusion (distance to the skin) of
+ * the bone that comes out through one of its own triangles: a bone vertex
+ * newly out of the skin, without the response, whose nearest skin point
+ * lies on one of them or that lies over one of them (its projection on
+ * the triangle's plane inside it, on the outer side); those triangles must
+ * rise by that much to cover it (cover_depth). */
 #define MOVE_SLACK 1e-3
-/* Bone vertices newly out of the skin whose protrusion bounds a skin
- * vertex's outward move: those within this distance of it (the response
- * lifts the skin over an anchor triangle and a 15 mm falloff beyond). */
-#define POKE_REACH 0.045
 #define MAX_POKES 20000
 #define MIN_FALL_SKIN_IN_BONE 0.95
-#define MIN_FALL_BONE_OUT 0.0
+#define MIN_FALL_BONE_OUT 0.95
 
 typedef struct body {
     pose_rig *rig;
@@ -94,19 +92,51 @@ static double skin_distance(const body *b, const float *x, const float *p)
     return d;
 }
 
-/* The depth of bone that comes through the skin near skin point p: the
- * largest protrusion (poke[4 k + 3], the distance of a bone vertex newly
- * out of the skin to the skin) among those within POKE_REACH of p. */
-static double poke_depth(const float *poke, size_t pokes, const float *p)
+/* Per skin vertex (cover[v], zeroed by the caller), the largest
+ * protrusion poke[4 k + 3] of the bone vertices poke[4 k] that come out
+ * through one of its triangles of the skin `x`: nearest to it (within
+ * 1e-6 of the least distance: a nearest edge or corner is every
+ * touching triangle's), or over it. */
+static void cover_depth(const body *b, const float *x, const float *poke, size_t pokes, double *cover)
 {
-    double depth = 0.0;
+    pose_tissue_info ti;
+    assert_int_equal(pose_rig_tissue_info(b->rig, b->skin, &ti), POSE_OK);
     for (size_t k = 0; k < pokes; k++) {
         const float *q = poke + 4 * k;
-        const double dx = (double)q[0] - p[0], dy = (double)q[1] - p[1], dz = (double)q[2] - p[2];
-        if (dx * dx + dy * dy + dz * dz < POKE_REACH * POKE_REACH)
-            depth = fmax(depth, q[3]);
+        for (size_t f = 0; f < ti.triangle_count; f++) {
+            const uint32_t *t = ti.triangles + 3 * f;
+            const float *a = x + 3 * (size_t)t[0], *u = x + 3 * (size_t)t[1], *w = x + 3 * (size_t)t[2];
+            int through = tri_distance(q, a, u, w) <= (double)q[3] + 1e-6;
+            if (!through) {
+                double e1[3], e2[3], r[3], n[3];
+                for (int d = 0; d < 3; d++) {
+                    e1[d] = (double)u[d] - a[d];
+                    e2[d] = (double)w[d] - a[d];
+                    r[d] = (double)q[d] - a[d];
+                }
+                n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+                n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+                n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+                const double nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+                if (!(nn > 0.0) || n[0] * r[0] + n[1] * r[1] + n[2] * r[2] <= 0.0)
+                    continue;
+                /* barycentric coordinates of the projection: signed areas */
+                double c1[3], c2[3];
+                c1[0] = r[1] * e2[2] - r[2] * e2[1];
+                c1[1] = r[2] * e2[0] - r[0] * e2[2];
+                c1[2] = r[0] * e2[1] - r[1] * e2[0];
+                c2[0] = e1[1] * r[2] - e1[2] * r[1];
+                c2[1] = e1[2] * r[0] - e1[0] * r[2];
+                c2[2] = e1[0] * r[1] - e1[1] * r[0];
+                const double s1 = (c1[0] * n[0] + c1[1] * n[1] + c1[2] * n[2]) / nn,
+                             s2 = (c2[0] * n[0] + c2[1] * n[1] + c2[2] * n[2]) / nn;
+                through = s1 >= 0.0 && s2 >= 0.0 && s1 + s2 <= 1.0;
+            }
+            if (through)
+                for (int i = 0; i < 3; i++)
+                    cover[t[i]] = fmax(cover[t[i]], q[3]);
+        }
     }
-    return depth;
 }
 
 static void set_response(pose_state *st, int on)
@@ -204,7 +234,9 @@ static void skin_out_of_bone(void **unused)
     printf("response built in %.0f ms, margin %.2f mm\n", 1e3 * rs.build_seconds, 1e3 * rs.margin);
 
     float *off = malloc(3 * b.skin_count * sizeof(float)), *poke = malloc(4 * MAX_POKES * sizeof(float));
+    double *cover = malloc(b.skin_count * sizeof(double));
     assert_non_null(off);
+    assert_non_null(cover);
     assert_non_null(poke);
     const pose_method methods[] = {POSE_LBS, POSE_DQS};
     const char *names[] = {"LBS", "DQS"};
@@ -236,6 +268,8 @@ static void skin_out_of_bone(void **unused)
                         pokes++;
                     }
             }
+            memset(cover, 0, b.skin_count * sizeof(double));
+            cover_depth(&b, off, poke, pokes, cover);
             /* With the response on, bones follow their joints rigidly: depths
              * are measured in those bones, from the skin without the push. */
             set_response(st, 1);
@@ -253,7 +287,7 @@ static void skin_out_of_bone(void **unused)
                     e += ((double)on[3 * v + (size_t)d] - off[3 * v + (size_t)d]) *
                          ((double)on[3 * v + (size_t)d] - off[3 * v + (size_t)d]);
                 const double move = sqrt(e),
-                             depth = fmax(bone_depth(&b, st, off + 3 * v), poke_depth(poke, pokes, off + 3 * v));
+                             depth = fmax(bone_depth(&b, st, off + 3 * v), cover[v]);
                 excess = fmax(excess, move - depth);
                 max_move = fmax(max_move, move);
                 moved++;
@@ -301,6 +335,7 @@ static void skin_out_of_bone(void **unused)
     pose_state_free(one);
     free(off);
     free(poke);
+    free(cover);
     free(rest_in);
     for (int i = 0; i < b.bone_count; i++)
         free(rest_out[i]);

@@ -97,21 +97,40 @@ POSE_API const uint8_t *pose_contact_vertex_flags(const pose_contact *contact, i
                                                   size_t *vertex_count);
 
 /*
- * Response (issue 13 part 2): skin pushed out of bone in the kinematic
- * methods. With it on, pose_apply ends with a position-level projection:
- * every skin vertex inside a bone, or outside it by less than the margin,
- * moves to the bone's nearest surface point plus the margin along the
- * outward direction. Bones move rigidly with their joints, so each is
- * queried in its rest frame: exact nearest triangle (a BVH of the bone's
- * mesh), sign by angle-weighted pseudo-normals, and a coarse grid per bone
- * that rejects far points at once. Skin inside a bone at rest (the orbits'
- * and the mouth's, in the skull and jaw) is anatomy and is left alone.
+ * Response (issue 13 part 2): skin kept over and out of bone in the
+ * kinematic methods. With it on, pose_apply ends with a position-level
+ * projection, one move per skin vertex, in two parts:
+ *  - cover: a bone vertex that posing brings out of the skin (inside the
+ *    rest skin within 40 mm of it, outside the posed skin by its winding
+ *    number, as pose_contact_detect counts) lifts the skin triangle it
+ *    lies over (its projection inside it, on the outer side) or is nearest
+ *    to: the triangle's corners move outward by the bone vertex's distance
+ *    to the skin plus the margin (along the lift-weighted mean of their
+ *    lifted triangles' normals, divided by the cosine to each triangle's
+ *    normal, at most 0.4 mm more), so that bone coming out between skin
+ *    vertices (through the middle of a triangle whose corners all lie
+ *    outside every bone) is covered; a triangle inside another layer of
+ *    skin (a fold) lifts nothing;
+ *  - push: then every skin vertex inside a bone, or outside it by less
+ *    than the margin, moves to the bone's nearest surface point plus the
+ *    margin along the outward direction.
+ * Bones move rigidly with their joints, so each is queried in its rest
+ * frame: exact nearest triangle (a BVH of the bone's mesh), sign by
+ * angle-weighted pseudo-normals, a coarse grid per bone that rejects far
+ * points at once, and a tree of the bone's vertices near the skin for the
+ * cover; the skin's triangles are queried only where they have moved,
+ * relative to a bone, farther than they lay from its vertices at rest.
+ * Skin inside a bone at rest (the orbits' and the mouth's, in the skull and
+ * jaw) is anatomy and is left alone.
  *
- * What it guarantees: a skin vertex moves once, by at most its depth in the
- * bone plus the margin (out of the first bone in the rig's order that holds
- * it; pushed into another, it stays there), and never when it is farther
- * than the margin outside every bone; the same bits for any thread count. Skin normals stay as the
- * transfer made them. Bone vertices are not moved.
+ * What it guarantees: a skin vertex moves once, by at most the larger of
+ * its depth in a bone plus the margin and the protrusion of the bone that
+ * comes out through one of its own triangles plus the margin and 0.4 mm (a
+ * lifted vertex that the push moves on is brought back within that; pushed
+ * out of the first bone in the rig's order that holds it into another, it
+ * stays there), and never when neither applies; the same bits for any
+ * thread count. Skin normals stay as the transfer made them. Bone vertices
+ * are not moved. pose_step (below) pushes without the cover.
  *
  * Cost: the first pose_set_contact_response that enables it (or changes
  * the margin) builds the bones' structures with the state's allocator
@@ -148,7 +167,7 @@ POSE_API const uint8_t *pose_contact_vertex_flags(const pose_contact *contact, i
  * contact ends when the node is beyond the plane by a tenth of the
  * margin, and never pulls. pose_reset_dynamics, and turning the response
  * off and on, forget these contacts. Then, after the transfer, the skin is pushed out of bone as
- * pose_apply pushes it (the simulation mesh is coarser than the skin:
+ * pose_apply pushes it, without the cover (the simulation mesh is coarser than the skin:
  * bone comes through between nodes). Nodes inside a bone at rest are
  * anatomy, left alone. The first pose_step with the response on finds the
  * nodes (allocating with the state's allocator); later steps allocate
@@ -168,8 +187,8 @@ typedef struct pose_contact_response {
 /** What the last pose_apply's (or pose_step's) push of the skin did. */
 typedef struct pose_contact_response_stats {
     size_t size;          /**< sizeof(pose_contact_response_stats), set by the caller */
-    size_t pushed;        /**< skin vertices moved */
-    float max_push;       /**< longest move, rig units */
+    size_t pushed;        /**< skin vertices moved (lifted over bone, pushed out of it, or both) */
+    float max_push;       /**< longest move of one, rig units */
     float margin;         /**< the margin in effect */
     double seconds;       /**< wall time of the pass */
     double build_seconds; /**< building the bones' structures */
