@@ -442,6 +442,11 @@ static void test_api_errors(void **state)
 
 int main(void)
 {
+    /* TSan's stage runs the threaded test alone (tests/fem/CMakeLists.txt):
+     * the others' solves take minutes under it and start no threads */
+    const char *only = getenv("POSE_TEST_ONLY");
+    if (only)
+        cmocka_set_test_filter(only);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_force_is_energy_gradient),
         cmocka_unit_test(test_api_errors),
