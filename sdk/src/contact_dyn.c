@@ -166,10 +166,11 @@ static pose__push_rest *rest_of(pose__push *p, size_t entry, size_t j)
 }
 
 /* Where the node ends the step (x + dt v), relative to its resting
- * contacts' planes: the method of multipliers' update F -= k (y - a) . m,
- * so that over the steps F comes to the force that holds the node on its
- * plane; one that would pull (the bone moves away, or the tissue draws
- * the node off) ends: contact pushes, never holds. Then the constraints
+ * contacts' planes: the method of multipliers' update F -= k (y - a) . m
+ * (F >= 0: contact pushes, never holds), so that over the steps F comes
+ * to the force that holds the node on its plane; a node that has left
+ * its plane (the bone moves away, or the tissue draws it off) ends that
+ * contact. Then the constraints
  * this step's response pushed with (lam > 0) on bones it did not rest on
  * become resting contacts on their planes, from the next step on
  * (multiplier 0: the spring takes the load at once, the multiplier over
@@ -183,21 +184,32 @@ static void rest_update(pose__push *p, size_t entry, float k, const float *x, co
     int squeezed = 0;
     for (int c = 0; nc && c < nc->count; c++)
         squeezed |= lam[c] > 0.0f && !rest_of(p, entry, nc->bone[c]);
-    int n = 0;
+    int n = 0, ended = 0;
+    uint16_t gone[POSE__PUSH_NODE_BONES];
     for (int i = 0; i < p->rest_count[entry]; i++) {
         float off = 0.0f;
         for (int e = 0; e < 3; e++)
             off += r[i].m[e] * (x[e] + dt * vel[e] - r[i].a[e]);
-        if (left(off, p->margin))
+        if (left(off, p->margin)) {
+            gone[ended++] = r[i].bone;
             continue;
+        }
         if (!squeezed)
             r[i].force = fmaxf(0.0f, r[i].force - k * off);
         r[n++] = r[i];
     }
+    p->rest_count[entry] = (uint8_t)n; /* rest_of sees only the contacts kept */
     for (int c = 0; nc && c < nc->count && n < POSE__PUSH_NODE_BONES; c++) {
-        if (!(lam[c] > 0.0f) || rest_of(p, entry, nc->bone[c]))
+        /* a contact that ended in this step starts again from the next one
+         * (at once, nodes let go and came back: 4.1 CG iterations a step held
+         * at the knees against 1.9) */
+        int again = 0;
+        for (int g = 0; g < ended; g++)
+            again |= gone[g] == nc->bone[c];
+        if (!(lam[c] > 0.0f) || again || rest_of(p, entry, nc->bone[c]))
             continue;
-        pose__push_rest *t = &r[n++];
+        pose__push_rest *t = &r[n];
+        p->rest_count[entry] = (uint8_t)++n;
         memcpy(t->q, nc->q[c], sizeof t->q);
         memcpy(t->n, nc->out[c], sizeof t->n);
         t->bone = nc->bone[c];
@@ -217,7 +229,6 @@ static void rest_update(pose__push *p, size_t entry, float k, const float *x, co
             }
         }
     }
-    p->rest_count[entry] = (uint8_t)n;
 }
 
 static void contact_item(void *ctx, size_t item)
