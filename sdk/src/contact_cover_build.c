@@ -11,6 +11,7 @@
 #include "contact_build.h"
 #include "contact_push.h"
 #include "error.h"
+#include "morton.h"
 #include "state_internal.h"
 
 typedef struct cover_build {
@@ -98,30 +99,6 @@ static pose_status bone_points(cover_build *b, size_t j, const pose__tissue *ts)
     return pose__bvh_build(&l->trees[j], b->a, pts, n, ts->positions);
 }
 
-static uint64_t spread(uint64_t v) /* 21 bits -> every third bit */
-{
-    v &= 0x1fffff;
-    v = (v | v << 32) & 0x1f00000000ffffull;
-    v = (v | v << 16) & 0x1f0000ff0000ffull;
-    v = (v | v << 8) & 0x100f00f00f00f00full;
-    v = (v | v << 4) & 0x10c30c30c30c30c3ull;
-    v = (v | v << 2) & 0x1249249249249249ull;
-    return v;
-}
-
-typedef struct tri_key {
-    uint64_t key;
-    uint32_t tri;
-} tri_key;
-
-static int cmp_key(const void *x, const void *y)
-{
-    const tri_key *p = x, *q = y;
-    if (p->key != q->key)
-        return p->key < q->key ? -1 : 1;
-    return p->tri < q->tri ? -1 : p->tri > q->tri;
-}
-
 /* Triangles in Morton order of their rest centroids (runs of
  * POSE__COVER_CLUSTER are compact clusters). */
 static pose_status order_triangles(cover_build *b)
@@ -130,28 +107,23 @@ static pose_status order_triangles(cover_build *b)
     const size_t nt = l->tri_count;
     l->cluster_count = (nt + POSE__COVER_CLUSTER - 1) / POSE__COVER_CLUSTER;
     l->tris = pose__alloc(b->a, (3 * nt + 1) * sizeof *l->tris, POSE__ALIGN);
-    tri_key *k = pose__alloc(b->a, (nt + 1) * sizeof *k, POSE__ALIGN);
+    pose__morton *k = pose__alloc(b->a, (nt + 1) * sizeof *k, POSE__ALIGN);
     if (!l->tris || !k) {
         pose__free(b->a, k);
         return oom("triangles");
     }
     const pose__bvh_node *root = &l->skin.nodes[0];
     for (size_t f = 0; f < nt; f++) {
-        uint64_t key = 0;
-        for (int d = 0; d < 3; d++) {
-            float c = 0.0f;
+        float c[3] = {0.0f, 0.0f, 0.0f};
+        for (int d = 0; d < 3; d++)
             for (int i = 0; i < 3; i++)
-                c += l->skin_rest[3 * (size_t)b->skin_tris[3 * f + (size_t)i] + (size_t)d] / 3.0f;
-            const float span = root->hi[d] - root->lo[d];
-            const float e = span > 0.0f ? fminf(fmaxf((c - root->lo[d]) / span, 0.0f), 1.0f) : 0.0f;
-            key |= spread((uint64_t)(e * 1048575.0f)) << d;
-        }
-        k[f] = (tri_key){key, (uint32_t)f};
+                c[d] += l->skin_rest[3 * (size_t)b->skin_tris[3 * f + (size_t)i] + (size_t)d] / 3.0f;
+        k[f] = (pose__morton){pose__morton_key(c, root->lo, root->hi), (uint32_t)f};
     }
-    qsort(k, nt, sizeof *k, cmp_key);
+    qsort(k, nt, sizeof *k, pose__morton_cmp);
     for (size_t f = 0; f < nt; f++)
         for (int i = 0; i < 3; i++)
-            l->tris[3 * f + (size_t)i] = b->skin_tris[3 * (size_t)k[f].tri + (size_t)i];
+            l->tris[3 * f + (size_t)i] = b->skin_tris[3 * (size_t)k[f].index + (size_t)i];
     pose__free(b->a, k);
     return POSE_OK;
 }

@@ -10,6 +10,7 @@
 #include "contact_cover.h"
 #include "contact_push.h"
 #include "error.h"
+#include "morton.h"
 #include "state_internal.h"
 
 /* Grid spacing: a 128th of the bone's longest side, within [2, 4] mm (rig
@@ -356,41 +357,6 @@ static pose_status bone_grid(pose__push_bone *b, const pose__tissue *ts, float m
     return r;
 }
 
-typedef struct morton_key {
-    uint64_t key;
-    uint32_t vertex;
-} morton_key;
-
-static int cmp_morton(const void *x, const void *y)
-{
-    const morton_key *p = x, *q = y;
-    if (p->key != q->key)
-        return p->key < q->key ? -1 : 1;
-    return p->vertex < q->vertex ? -1 : p->vertex > q->vertex;
-}
-
-static uint64_t spread(uint64_t v) /* 21 bits -> every third bit */
-{
-    v &= 0x1fffff;
-    v = (v | v << 32) & 0x1f00000000ffffull;
-    v = (v | v << 16) & 0x1f0000ff0000ffull;
-    v = (v | v << 8) & 0x100f00f00f00f00full;
-    v = (v | v << 4) & 0x10c30c30c30c30c3ull;
-    v = (v | v << 2) & 0x1249249249249249ull;
-    return v;
-}
-
-/* x's Morton key in the box [lo, hi]. */
-static uint64_t morton_of(const float *x, const float *lo, const float *hi)
-{
-    uint64_t key = 0;
-    for (int d = 0; d < 3; d++) {
-        const float e = hi[d] > lo[d] ? (x[d] - lo[d]) / (hi[d] - lo[d]) : 0.0f;
-        key |= spread((uint64_t)(e * 1048575.0f)) << d;
-    }
-    return key;
-}
-
 /* Skin vertices in Morton order of their rest positions: consecutive runs
  * of POSE__PUSH_CLUSTER are compact clusters. */
 static pose_status skin_order(pose__push *p, const pose_state *st)
@@ -405,7 +371,7 @@ static pose_status skin_order(pose__push *p, const pose_state *st)
     p->order = pose__alloc(&p->allocator, (n + 1) * sizeof *p->order, POSE__ALIGN);
     p->skip = pose__calloc(&p->allocator, n + 1, POSE__ALIGN);
     p->cache = pose__alloc(&p->allocator, (n + 1) * sizeof *p->cache, POSE__ALIGN);
-    morton_key *k = pose__alloc(&p->allocator, (n + 1) * sizeof *k, POSE__ALIGN);
+    pose__morton *k = pose__alloc(&p->allocator, (n + 1) * sizeof *k, POSE__ALIGN);
     if (!p->order || !p->skip || !p->cache || !k) {
         pose__free(&p->allocator, k);
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu skin vertices", n);
@@ -423,11 +389,11 @@ static pose_status skin_order(pose__push *p, const pose_state *st)
         if (ts->kind != POSE_TISSUE_SKIN)
             continue;
         for (size_t v = 0; v < ts->vertex_count; v++, i++)
-            k[i] = (morton_key){morton_of(ts->positions + 3 * v, lo, hi), (uint32_t)(st->rt->tissue_offset[t] + v)};
+            k[i] = (pose__morton){pose__morton_key(ts->positions + 3 * v, lo, hi), (uint32_t)(st->rt->tissue_offset[t] + v)};
     }
-    qsort(k, n, sizeof *k, cmp_morton);
+    qsort(k, n, sizeof *k, pose__morton_cmp);
     for (i = 0; i < n; i++) {
-        p->order[i] = k[i].vertex;
+        p->order[i] = k[i].index;
         p->cache[i].slot[0].bone = p->cache[i].slot[1].bone = UINT32_MAX;
     }
     pose__free(&p->allocator, k);
@@ -630,7 +596,7 @@ pose_status pose__push_build_nodes(pose__push *p, const pose_state *st)
     p->rest_on = pose__alloc(a, nv + 1, POSE__ALIGN);
     p->rest_stiff = pose__alloc(a, 6 * (nv + 1) * sizeof(float), POSE__ALIGN);
     p->rest_force = pose__alloc(a, 3 * (nv + 1) * sizeof(float), POSE__ALIGN);
-    morton_key *k = pose__alloc(a, (nv + 1) * sizeof *k, POSE__ALIGN);
+    pose__morton *k = pose__alloc(a, (nv + 1) * sizeof *k, POSE__ALIGN);
     if (!p->nodes || !p->node_bone || !p->node_gap || !p->node_cache || !p->rest_count || !p->rests ||
         !p->rest_on || !p->rest_stiff || !p->rest_force || !k) {
         pose__free(a, k);
@@ -644,11 +610,11 @@ pose_status pose__push_build_nodes(pose__push *p, const pose_state *st)
     size_t n = 0;
     for (size_t v = 0; v < nv; v++)
         if (m->corner_offset[v + 1] > m->corner_offset[v] && m->mass[v] > 0.0f && m->inv_diag[v] != 0.0f)
-            k[n++] = (morton_key){morton_of(rest + 3 * v, lo, hi), (uint32_t)v};
-    qsort(k, n, sizeof *k, cmp_morton);
+            k[n++] = (pose__morton){pose__morton_key(rest + 3 * v, lo, hi), (uint32_t)v};
+    qsort(k, n, sizeof *k, pose__morton_cmp);
     size_t kept = 0;
     for (size_t i = 0; i < n; i++) {
-        const uint32_t v = k[i].vertex;
+        const uint32_t v = k[i].index;
         if (rest_gap(p, rest + 3 * (size_t)v, &p->node_bone[kept], &p->node_gap[kept]))
             continue;
         p->node_cache[kept].slot[0].bone = p->node_cache[kept].slot[1].bone = UINT32_MAX;
