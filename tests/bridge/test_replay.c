@@ -165,9 +165,12 @@ static void test_realtime_pacing(void **state)
      * the median wake-up is late by scheduling noise only, not by a frame */
     assert_true(run_realtime(f, 1.0, 60, 0) < ft);
     assert_true(run_realtime(f, 2.0, 60, 0) < ft / 2);
-    /* as fast as possible: 600 frames (5 s of clip) in well under real time */
+    /* as fast as possible: 600 frames (5 s of clip) in under half of real
+     * time, which a paced run cannot do (a quarter failed once in .ci/run
+     * on the loaded 2-core machine: wall time, not pacing) */
     double span = run_realtime(f, 1.0, 600, 1);
-    assert_true(span < 599 * ft / 4);
+    print_message("as fast as possible: 599 frames in %.3f s (real time %.3f s)\n", span, 599 * ft);
+    assert_true(span < 599 * ft / 2);
 }
 
 static const pb_pose *wait_fresh(pb_runner *r)
