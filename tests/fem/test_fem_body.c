@@ -14,6 +14,7 @@
 
 #include <cmocka.h>
 
+#include "fem_body_rig.h"
 #include "fem_postures.h"
 #include "fem_volume.h"
 #include "pose/pose.h"
@@ -44,12 +45,8 @@ static double skin_volume(const pose_state *st)
 static int setup(void **state)
 {
     (void)state;
-    const char *path = getenv("POSE_FEM_RIG");
-    if (!path || pose_rig_load(path, &g_rig) != POSE_OK) {
-        fprintf(stderr, "cannot load POSE_FEM_RIG=%s: %s\n", path ? path : "(unset)",
-                pose_last_error());
+    if (!(g_rig = fem_body_rig_load()))
         return -1;
-    }
     for (size_t t = 0; t < pose_rig_tissue_count(g_rig); t++) {
         pose_tissue_info info;
         pose_rig_tissue_info(g_rig, (int)t, &info);

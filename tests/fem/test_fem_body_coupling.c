@@ -19,6 +19,7 @@
 
 #include <cmocka.h>
 
+#include "fem_body_rig.h"
 #include "fem_postures.h"
 #include "pose/pose.h"
 #include "tri_distance.h"
@@ -40,12 +41,8 @@ static size_t g_shin_count;
 static int setup(void **state)
 {
     (void)state;
-    const char *path = getenv("POSE_FEM_RIG");
-    if (!path || pose_rig_load(path, &g_rig) != POSE_OK) {
-        fprintf(stderr, "cannot load POSE_FEM_RIG=%s: %s\n", path ? path : "(unset)",
-                pose_last_error());
+    if (!(g_rig = fem_body_rig_load()))
         return -1;
-    }
     g_skin = -1;
     for (size_t t = 0; t < pose_rig_tissue_count(g_rig) && g_skin < 0; t++) {
         pose_tissue_info info;

@@ -18,6 +18,7 @@
 
 #include <cmocka.h>
 
+#include "fem_body_rig.h"
 #include "fem_postures.h"
 #include "pose/pose.h"
 
@@ -30,12 +31,8 @@ static pose_rig *g_rig;
 static int setup(void **state)
 {
     (void)state;
-    const char *path = getenv("POSE_FEM_RIG");
-    if (!path || pose_rig_load(path, &g_rig) != POSE_OK) {
-        fprintf(stderr, "cannot load POSE_FEM_RIG=%s: %s\n", path ? path : "(unset)",
-                pose_last_error());
+    if (!(g_rig = fem_body_rig_load()))
         return -1;
-    }
     return 0;
 }
 

@@ -20,6 +20,7 @@
 
 #include <cmocka.h>
 
+#include "fem_body_rig.h"
 #include "pose/pose.h"
 
 #define REACH 0.05f /* rig units (m) */
@@ -38,12 +39,8 @@ static size_t g_crossing; /* springs whose ends lie in different 1024-vertex chu
 static int setup(void **state)
 {
     (void)state;
-    const char *path = getenv("POSE_FEM_RIG");
-    if (!path || pose_rig_load(path, &g_rig) != POSE_OK) {
-        fprintf(stderr, "cannot load POSE_FEM_RIG=%s: %s\n", path ? path : "(unset)",
-                pose_last_error());
+    if (!(g_rig = fem_body_rig_load()))
         return -1;
-    }
     g_knee[0] = pose_rig_find_joint(g_rig, "knee_r");
     g_knee[1] = pose_rig_find_joint(g_rig, "knee_l");
     pose_tet_info tet;
