@@ -98,8 +98,15 @@ static int boxes_meet(const tri_box *a, const tri_box *b)
     return 1;
 }
 
-/* Intersecting pairs between leaves a and b (a == b: within the leaf). */
-static size_t leaf_pairs(const pose__bvh *t, const float *positions, uint32_t a, uint32_t b)
+/* Parts of the triangles and nodes (pose__bvh_self_task_parts), or none. */
+typedef struct parts {
+    const uint32_t *tri, *node;
+} parts;
+
+/* Intersecting pairs between leaves a and b (a == b: within the leaf); with
+ * parts, only pairs of triangles of different parts. */
+static size_t leaf_pairs(const pose__bvh *t, const float *positions, uint32_t a, uint32_t b,
+                         const parts *pt)
 {
     const pose__bvh_node *na = &t->nodes[a], *nb = &t->nodes[b];
     tri_box ba[POSE__BVH_LEAF], bb[POSE__BVH_LEAF];
@@ -110,8 +117,11 @@ static size_t leaf_pairs(const pose__bvh *t, const float *positions, uint32_t a,
         for (uint32_t j = a == b ? i + 1 : 0; j < nb->count; j++) {
             if (!boxes_meet(&ba[i], &bb[j]))
                 continue;
-            const uint32_t *ti = t->triangles + 3 * (size_t)t->items[na->first + i];
-            const uint32_t *tj = t->triangles + 3 * (size_t)t->items[nb->first + j];
+            const uint32_t ii = t->items[na->first + i], ij = t->items[nb->first + j];
+            if (pt && pt->tri[ii] == pt->tri[ij])
+                continue;
+            const uint32_t *ti = t->triangles + 3 * (size_t)ii;
+            const uint32_t *tj = t->triangles + 3 * (size_t)ij;
             if (!pose__tris_share_vertex(ti, tj) && pose__tri_tri_intersect(ba[i].v, bb[j].v))
                 hits++;
         }
@@ -127,7 +137,8 @@ static float extent(const pose__bvh_node *n)
  * pop pushes at most three and the path is at most twice the depth long. */
 #define PAIR_STACK (8 * POSE__BVH_MAX_DEPTH)
 
-static size_t pairs_from(const pose__bvh *t, const float *positions, uint32_t a0, uint32_t b0)
+static size_t pairs_from(const pose__bvh *t, const float *positions, uint32_t a0, uint32_t b0,
+                         const parts *pt)
 {
     uint32_t stack[PAIR_STACK][2];
     int top = 0;
@@ -138,9 +149,12 @@ static size_t pairs_from(const pose__bvh *t, const float *positions, uint32_t a0
         top--;
         const uint32_t a = stack[top][0], b = stack[top][1];
         const pose__bvh_node *na = &t->nodes[a], *nb = &t->nodes[b];
+        /* A node, or two nodes, all of one part hold no pair to count. */
+        if (pt && pt->node[a] != POSE__BVH_MIXED && pt->node[a] == pt->node[b])
+            continue;
         if (a == b) {
             if (na->count) {
-                hits += leaf_pairs(t, positions, a, a);
+                hits += leaf_pairs(t, positions, a, a, pt);
             } else {
                 const uint32_t l = na->first, r = na->first + 1;
                 stack[top][0] = l, stack[top++][1] = l;
@@ -152,7 +166,7 @@ static size_t pairs_from(const pose__bvh *t, const float *positions, uint32_t a0
         if (!overlap(na, nb))
             continue;
         if (na->count && nb->count) {
-            hits += leaf_pairs(t, positions, a, b);
+            hits += leaf_pairs(t, positions, a, b, pt);
             continue;
         }
         /* Open the inner node, the larger one when both are. */
@@ -165,12 +179,42 @@ static size_t pairs_from(const pose__bvh *t, const float *positions, uint32_t a0
     return hits;
 }
 
-size_t pose__bvh_self_task(const pose__bvh *t, const float *positions, uint32_t task)
+static size_t self_task(const pose__bvh *t, const float *positions, uint32_t task, const parts *pt)
 {
     const uint32_t n = t->split_nodes[task];
     if (task < t->split_pairs)
-        return pairs_from(t, positions, t->nodes[n].first, t->nodes[n].first + 1);
-    return pairs_from(t, positions, n, n);
+        return pairs_from(t, positions, t->nodes[n].first, t->nodes[n].first + 1, pt);
+    return pairs_from(t, positions, n, n, pt);
+}
+
+size_t pose__bvh_self_task(const pose__bvh *t, const float *positions, uint32_t task)
+{
+    return self_task(t, positions, task, NULL);
+}
+
+size_t pose__bvh_self_task_parts(const pose__bvh *t, const float *positions, uint32_t task,
+                                 const uint32_t *tri_part, const uint32_t *node_part)
+{
+    const parts pt = {tri_part, node_part};
+    return self_task(t, positions, task, &pt);
+}
+
+void pose__bvh_node_parts(const pose__bvh *t, const uint32_t *tri_part, uint32_t *node_part)
+{
+    /* Parents come before children: children are done first from the end. */
+    for (uint32_t n = t->node_count; n-- > 0;) {
+        const pose__bvh_node *nd = &t->nodes[n];
+        uint32_t part;
+        if (nd->count) {
+            part = tri_part[t->items[nd->first]];
+            for (uint32_t i = 1; i < nd->count; i++)
+                if (tri_part[t->items[nd->first + i]] != part)
+                    part = POSE__BVH_MIXED;
+        } else {
+            part = node_part[nd->first] == node_part[nd->first + 1] ? node_part[nd->first] : POSE__BVH_MIXED;
+        }
+        node_part[n] = part;
+    }
 }
 
 int pose__bvh_winding(const pose__bvh *t, const float *positions, const float *p)

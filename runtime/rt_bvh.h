@@ -50,6 +50,21 @@ void pose__bvh_refit_inner(pose__bvh *t);
  *  self-intersection task `task` (0 .. split_count - 1). */
 size_t pose__bvh_self_task(const pose__bvh *t, const float *positions, uint32_t task);
 
+/** A node whose triangles are not all of one part (pose__bvh_node_parts). */
+#define POSE__BVH_MIXED UINT32_MAX
+
+/** The part of each node of t: the part all its triangles share (tri_part,
+ *  per triangle id, none POSE__BVH_MIXED), or POSE__BVH_MIXED. node_part
+ *  holds node_count entries. */
+void pose__bvh_node_parts(const pose__bvh *t, const uint32_t *tri_part, uint32_t *node_part);
+
+/** As pose__bvh_self_task, counting only pairs of triangles of different
+ *  parts; nodes of one part are not opened against themselves or each
+ *  other (bone meshes against each other: the pairs within one bone are
+ *  never looked at). */
+size_t pose__bvh_self_task_parts(const pose__bvh *t, const float *positions, uint32_t task,
+                                 const uint32_t *tri_part, const uint32_t *node_part);
+
 /** Winding number at p of the triangles of t (a ray along +x). */
 int pose__bvh_winding(const pose__bvh *t, const float *positions, const float *p);
 

@@ -137,8 +137,8 @@ int main(int argc, char **argv)
             } while (bench_now() - w0 < seconds || frames < 3);
             const double wall = (bench_now() - w0) / frames, cpu = (bench_cpu_seconds() - c0) / frames;
             printf("  %-18s: %7.2f ms wall, %7.2f ms CPU per thread per frame; %zu skin pairs, %zu skin "
-                   "vertices in bone, %zu bone vertices out of skin\n", contact_poses[p].label, 1e3 * wall,
-                   1e3 * cpu / threads, n.skin_pairs, n.skin_in_bone, n.bone_out_of_skin);
+                   "vertices in bone, %zu bone vertices out of skin, %zu pairs of two bones\n", contact_poses[p].label,
+                   1e3 * wall, 1e3 * cpu / threads, n.skin_pairs, n.skin_in_bone, n.bone_out_of_skin, n.bone_pairs);
         }
         pose_contact_free(c);
     }

@@ -2,6 +2,7 @@
 /* pose/contact.h: collision detection between posed skin and bones. */
 #include "pose/contact.h"
 
+#include <stddef.h>
 #include <string.h>
 
 #include "alloc.h"
@@ -11,7 +12,10 @@
 #include "rt_thread.h"
 #include "state_internal.h"
 
-enum { COUNT_PAIRS, COUNT_SKIN_IN_BONE, COUNT_BONE_OUT, COUNT_KINDS };
+enum { COUNT_PAIRS, COUNT_SKIN_IN_BONE, COUNT_BONE_OUT, COUNT_BONE_PAIRS, COUNT_KINDS };
+
+/* The counts' first layout (no bone_pairs), still accepted. */
+#define COUNTS_SIZE_FIRST offsetof(pose_contact_counts, bone_pairs)
 
 struct pose_contact {
     const pose_rig *rig;
@@ -20,6 +24,8 @@ struct pose_contact {
     pose__bvh skin, bone;       /* trees over the skin's and the bones' triangles */
     uint32_t *skin_tris, *bone_tris; /* 3 per triangle, indices into all tissue vertices */
     uint32_t *skin_verts, *bone_verts; /* the tissue vertices of each kind */
+    uint32_t *bone_tri_tissue;  /* per bone triangle: its tissue (bone pairs are between two) */
+    uint32_t *bone_node_tissue; /* per node of the bone tree: its one tissue, or POSE__BVH_MIXED */
     size_t skin_vert_count, bone_vert_count;
     uint8_t *flags;             /* POSE_CONTACT_* per tissue vertex, all tissues */
     size_t (*part_counts)[COUNT_KINDS]; /* per part of the last detection */
@@ -29,7 +35,7 @@ struct pose_contact {
 /* Gather the triangles and vertices of the tissues of one kind, with
  * indices into the whole tissue vertex array (rt->tissue_offset). */
 static pose_status gather(pose_contact *c, pose_tissue_kind kind, uint32_t **tris, uint32_t *tri_count,
-                          uint32_t **verts, size_t *vert_count)
+                          uint32_t **verts, size_t *vert_count, uint32_t **tri_tissue)
 {
     const pose_rig *rig = c->rig;
     size_t nt = 0, nv = 0;
@@ -42,7 +48,9 @@ static pose_status gather(pose_contact *c, pose_tissue_kind kind, uint32_t **tri
         return pose__fail(POSE_ERR_INVALID_ARGUMENT, "pose_contact_create: %zu triangles", nt);
     *tris = pose__alloc(&c->allocator, (3 * nt + 1) * sizeof(uint32_t), POSE__ALIGN);
     *verts = pose__alloc(&c->allocator, (nv + 1) * sizeof(uint32_t), POSE__ALIGN);
-    if (!*tris || !*verts)
+    if (tri_tissue)
+        *tri_tissue = pose__alloc(&c->allocator, (nt + 1) * sizeof(uint32_t), POSE__ALIGN);
+    if (!*tris || !*verts || (tri_tissue && !*tri_tissue))
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu contact triangles", nt);
     size_t it = 0, iv = 0;
     for (size_t t = 0; t < rig->tissue_count; t++) {
@@ -50,6 +58,9 @@ static pose_status gather(pose_contact *c, pose_tissue_kind kind, uint32_t **tri
         if (ti->kind != kind)
             continue;
         const uint32_t base = (uint32_t)rig->rt->tissue_offset[t];
+        if (tri_tissue)
+            for (size_t f = 0; f < ti->triangle_count; f++)
+                (*tri_tissue)[it / 3 + f] = (uint32_t)t;
         for (size_t k = 0; k < 3 * ti->triangle_count; k++)
             (*tris)[it++] = base + ti->triangles[k];
         for (size_t v = 0; v < ti->vertex_count; v++)
@@ -75,6 +86,8 @@ void pose_contact_free(pose_contact *c)
     pose__free(&a, c->bone_tris);
     pose__free(&a, c->skin_verts);
     pose__free(&a, c->bone_verts);
+    pose__free(&a, c->bone_tri_tissue);
+    pose__free(&a, c->bone_node_tissue);
     pose__free(&a, c->flags);
     pose__free(&a, c->part_counts);
     pose__free(&a, c);
@@ -97,10 +110,10 @@ static pose_status build(pose_contact *c, unsigned threads)
 {
     uint32_t skin_tri_count, bone_tri_count;
     pose_status s = gather(c, POSE_TISSUE_SKIN, &c->skin_tris, &skin_tri_count, &c->skin_verts,
-                           &c->skin_vert_count);
+                           &c->skin_vert_count, NULL);
     if (s == POSE_OK)
         s = gather(c, POSE_TISSUE_BONE, &c->bone_tris, &bone_tri_count, &c->bone_verts,
-                   &c->bone_vert_count);
+                   &c->bone_vert_count, &c->bone_tri_tissue);
     if (s != POSE_OK)
         return s;
     const size_t n = c->rig->rt->tissue_offset[c->rig->tissue_count];
@@ -117,6 +130,10 @@ static pose_status build(pose_contact *c, unsigned threads)
     pose__free(&c->allocator, rest);
     if (s != POSE_OK)
         return s;
+    c->bone_node_tissue = pose__alloc(&c->allocator, (c->bone.node_count + 1) * sizeof(uint32_t), POSE__ALIGN);
+    if (!c->bone_node_tissue)
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for the bone tree's parts");
+    pose__bvh_node_parts(&c->bone, c->bone_tri_tissue, c->bone_node_tissue);
     c->pool = pose__alloc(&c->allocator, pose__pool_size(threads), POSE__ALIGN);
     if (!c->pool)
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for a pool of %u threads", threads);
@@ -185,10 +202,14 @@ static void detect_task(void *ctx, unsigned part, unsigned parts)
 {
     pose_contact *c = ctx;
     size_t *n = c->part_counts[part];
-    n[COUNT_PAIRS] = n[COUNT_SKIN_IN_BONE] = n[COUNT_BONE_OUT] = 0;
+    n[COUNT_PAIRS] = n[COUNT_SKIN_IN_BONE] = n[COUNT_BONE_OUT] = n[COUNT_BONE_PAIRS] = 0;
     if (c->skin.node_count)
         for (uint32_t i = part; i < c->skin.split_count; i += parts)
             n[COUNT_PAIRS] += pose__bvh_self_task(&c->skin, c->positions, i);
+    if (c->bone.node_count)
+        for (uint32_t i = part; i < c->bone.split_count; i += parts)
+            n[COUNT_BONE_PAIRS] += pose__bvh_self_task_parts(&c->bone, c->positions, i, c->bone_tri_tissue,
+                                                             c->bone_node_tissue);
     const size_t sb = pose__part_begin(c->skin_vert_count, part, parts),
                  se = pose__part_begin(c->skin_vert_count, part + 1, parts);
     for (size_t i = sb; i < se; i++) {
@@ -216,9 +237,10 @@ pose_status pose_contact_detect(pose_contact *c, const pose_state *st, pose_cont
         return pose__fail(POSE_ERR_INVALID_ARGUMENT, "pose_contact_detect: contact and state are required");
     if (st->rig != c->rig)
         return pose__fail(POSE_ERR_INVALID_ARGUMENT, "pose_contact_detect: the state is of another rig");
-    if (out && out->size != sizeof *out)
-        return pose__fail(POSE_ERR_INVALID_ARGUMENT, "pose_contact_detect: out->size %zu (expected %zu)",
-                          out->size, sizeof *out);
+    if (out && out->size != sizeof *out && out->size != COUNTS_SIZE_FIRST)
+        return pose__fail(POSE_ERR_INVALID_ARGUMENT,
+                          "pose_contact_detect: out->size %zu (expected %zu, or %zu for the first layout)",
+                          out->size, sizeof *out, (size_t)COUNTS_SIZE_FIRST);
     const double t0 = pose__seconds();
     c->positions = st->tissue_positions;
     pose__pool_run(c->pool, refit_task, c);
@@ -236,6 +258,8 @@ pose_status pose_contact_detect(pose_contact *c, const pose_state *st, pose_cont
         out->skin_in_bone = sum[COUNT_SKIN_IN_BONE];
         out->bone_out_of_skin = sum[COUNT_BONE_OUT];
         out->seconds = pose__seconds() - t0;
+        if (out->size == sizeof *out)
+            out->bone_pairs = sum[COUNT_BONE_PAIRS];
     }
     return POSE_OK;
 }

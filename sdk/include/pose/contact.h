@@ -12,7 +12,14 @@
  *    triangles, all tissues of kind POSE_TISSUE_BONE, by rays along +x and
  *    -x that must agree: a few bone meshes are open, and one ray through
  *    an open mesh can count a crossing without its partner);
- *  - bone vertices outside the skin (winding number of the skin).
+ *  - bone vertices outside the skin (winding number of the skin);
+ *  - triangle pairs of two different bones (tissues of kind
+ *    POSE_TISSUE_BONE) that intersect: bone through bone, which no
+ *    response to the skin can undo (the pose itself brings a joint's bones
+ *    into each other, or two limbs through each other). Pairs within one
+ *    bone mesh are not looked at; bones that touch or overlap at rest
+ *    (the jaw and skull, vertebrae, carpals in the bundled anatomy) count
+ *    at rest too.
  * Inside and outside assume closed, outward-oriented meshes (pose-bake's
  * inputs are); touching without crossing (a vertex exactly on a face)
  * counts as no contact.
@@ -56,6 +63,9 @@ typedef struct pose_contact_counts {
     size_t skin_in_bone;     /**< skin vertices inside a bone */
     size_t bone_out_of_skin; /**< bone vertices outside the skin */
     double seconds;          /**< wall time of the detection */
+    size_t bone_pairs;       /**< triangle pairs of two different bone tissues that intersect
+                                  (added to the struct later: a caller whose size
+                                  ends before it is accepted and it is not written) */
 } pose_contact_counts;
 
 /** Flags of a tissue vertex (pose_contact_vertex_flags). */
