@@ -770,9 +770,12 @@ POSE_API pose_status pose_get_dynamics_stats(const pose_state *state, pose_dynam
  * A node the simulation holds or does not move (a vertex of a bone tet, or
  * of no soft tet) is already tied to its bone: its coupling is ignored.
  *
- * ABI: arrays of pose_fem_coupling are passed with their element size
- * (sizeof(pose_fem_coupling)); a later version may append fields, read only
- * when the element size covers them.
+ * ABI: pose_set_fem_couplings takes its array with the element size
+ * (sizeof(pose_fem_coupling)), so a later version may append fields, read
+ * only when the element size covers them. pose_rig_fem_couplings and
+ * pose_rig_desc.fem_couplings have no element size: they are the 0.2
+ * layout, and stay so; a version that appends fields adds calls that take
+ * one (as the soft couplings' do).
  */
 typedef struct pose_fem_coupling {
     uint32_t node;     /**< simulation node: tet vertex index (pose_tet_positions) */
@@ -833,9 +836,11 @@ POSE_API size_t pose_fem_coupling_count(const pose_state *state);
  * simulation (a vertex of a bone tet, or of no soft tet) is ignored, as a
  * pose_fem_coupling on such a node is.
  *
- * ABI: arrays are passed with their element size
+ * ABI: the calls pass arrays with their element size
  * (sizeof(pose_fem_soft_coupling)); a later version may append fields,
  * read or written only where the element size covers them.
+ * pose_rig_desc.fem_soft_couplings has none: it is the 0.2 layout, and
+ * stays so.
  */
 typedef struct pose_fem_soft_coupling {
     uint32_t node;     /**< simulation node: tet vertex index (pose_tet_positions) */
