@@ -264,8 +264,9 @@ void pose__state_push_item(void *ctx, size_t item)
          * another stays there rather than move by more than its depth. (A
          * vertex not yet pushed has not moved: the spheres hold it.) */
         uint8_t done[POSE__PUSH_CLUSTER] = {0};
+        const uint8_t *reach = p->reach + c * p->reach_stride;
         for (size_t j = 0; j < p->bone_count; j++) {
-            if (!pose__push_cluster_near(p, j, cluster))
+            if (!(reach[j / 8] >> (j % 8) & 1u) || !pose__push_cluster_near(p, j, cluster))
                 continue;
             const pose__push_bone *b = &p->bones[j];
             const float *f = p->frames + 12 * j;

@@ -24,6 +24,13 @@
 #define POSE__PUSH_CLUSTER 32
 /** Skin vertices per group (a cluster's part, tested before its vertices). */
 #define POSE__PUSH_GROUP 4
+/** How near a bone must lie to a cluster of skin at rest for the push to
+ *  move that skin out of it (rig units: 40 mm): skin in a bone farther
+ *  away is in another part of the body (a thigh's skin in the fingers of a
+ *  hand posed into it), which pushing the skin cannot take out, and whose
+ *  small bones, moving through the skin, would throw it from side to side
+ *  from frame to frame. */
+#define POSE__PUSH_REACH 0.04f
 /** Items of the pass (runs of clusters; pose__pool_run_items gives them to
  *  whichever thread is free: the work gathers where skin lies on bone). */
 #define POSE__PUSH_ITEMS 128
@@ -96,6 +103,11 @@ typedef struct pose__push {
                                  weighted to it alone, at least RIGID_CLEARANCE from its bones
                                  at rest): they are not searched for it; -1: none */
     size_t vertex_count, cluster_count;
+    uint8_t *reach;         /**< per cluster, a bit per bone (reach_stride bytes): the bone
+                                 lies within POSE__PUSH_REACH of the cluster at rest, so the
+                                 cluster's skin covers it; the others are another part's
+                                 bones, not pushed out of */
+    size_t reach_stride;
     float *frames;          /**< per bone per frame: rotation (9, row-major) and translation */
     float *bone_spheres;    /**< per bone per frame: posed centre and radius */
     size_t pushed[POSE__PUSH_ITEMS]; /**< per item of the last pass */

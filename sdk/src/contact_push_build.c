@@ -422,6 +422,44 @@ static void mark_rest_inside(pose__push *p, const pose_state *st)
     }
 }
 
+/* Which bones each cluster of skin covers at rest (pose__push.reach). */
+static pose_status mark_reach(pose__push *p, const pose_state *st)
+{
+    p->reach_stride = (p->bone_count + 7) / 8;
+    p->reach = pose__calloc(&p->allocator, p->cluster_count * p->reach_stride + 1, POSE__ALIGN);
+    float *rest = pose__alloc(&p->allocator, (3 * p->vertex_count + 1) * sizeof(float), POSE__ALIGN);
+    if (!p->reach || !rest) {
+        pose__free(&p->allocator, rest);
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu skin clusters", p->cluster_count);
+    }
+    for (size_t i = 0; i < p->vertex_count; i++) {
+        const uint32_t v = p->order[i];
+        size_t t = 0;
+        while (st->rt->tissue_offset[t + 1] <= v)
+            t++;
+        memcpy(rest + 3 * i, st->rig->tissues[t].positions + 3 * (v - st->rt->tissue_offset[t]), 3 * sizeof(float));
+    }
+    for (size_t c = 0; c < p->cluster_count; c++) {
+        const size_t vb = c * POSE__PUSH_CLUSTER,
+                     ve = vb + POSE__PUSH_CLUSTER < p->vertex_count ? vb + POSE__PUSH_CLUSTER : p->vertex_count;
+        float sphere[4];
+        pose__push_sphere(rest, NULL, vb, ve, sphere);
+        for (size_t j = 0; j < p->bone_count; j++) {
+            const pose__push_bone *b = &p->bones[j];
+            const float reach = sphere[3] + POSE__PUSH_REACH;
+            float e2 = 0.0f, q[3], o[3];
+            for (int d = 0; d < 3; d++) { /* the bone's box first */
+                const float e = sphere[d] < b->lo[d] ? b->lo[d] - sphere[d] : sphere[d] > b->hi[d] ? sphere[d] - b->hi[d] : 0.0f;
+                e2 += e * e;
+            }
+            if (e2 <= reach * reach && pose__push_distance(b, sphere, reach, q, o) <= reach)
+                p->reach[c * p->reach_stride + j / 8] |= (uint8_t)(1u << (j % 8));
+        }
+    }
+    pose__free(&p->allocator, rest);
+    return POSE_OK;
+}
+
 /* How far from its own bones a skin vertex riding rigidly with them must
  * be at rest to be left out of their search: the margin and what the
  * dynamics' bone springs let a bone node lag (0.15 mm measured) with room. */
@@ -491,6 +529,7 @@ void pose__push_release(pose__push *p)
     pose__free(a, p->skip);
     pose__free(a, p->cache);
     pose__free(a, p->own_joint);
+    pose__free(a, p->reach);
     pose__free(a, p->frames);
     pose__free(a, p->bone_spheres);
     pose__free(a, p->nodes);
@@ -543,7 +582,7 @@ pose_status pose__push_build(pose__push *p, const pose_state *st, float margin)
     if (s != POSE_OK)
         return s;
     mark_rest_inside(p, st);
-    if ((s = mark_rigid(p, st)) != POSE_OK)
+    if ((s = mark_rigid(p, st)) != POSE_OK || (s = mark_reach(p, st)) != POSE_OK)
         return s;
     p->cover = pose__calloc(&p->allocator, sizeof *p->cover, POSE__ALIGN);
     if (!p->cover)

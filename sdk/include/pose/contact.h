@@ -123,7 +123,12 @@ POSE_API const uint8_t *pose_contact_vertex_flags(const pose_contact *contact, i
  *    skin (a fold) lifts nothing;
  *  - push: then every skin vertex inside a bone, or outside it by less
  *    than the margin, moves to the bone's nearest surface point plus the
- *    margin along the outward direction.
+ *    margin along the outward direction; only bones the skin covers count
+ *    (within 40 mm of its cluster of 32 skin vertices at rest): skin in
+ *    the bones of another part posed into it (a thigh's skin in the
+ *    fingers of a hand, one foot's in the other's) stays, since moving
+ *    skin cannot take the part out, and small bones moving through skin
+ *    would throw it from side to side between frames.
  * Bones move rigidly with their joints, so each is queried in its rest
  * frame: exact nearest triangle (a BVH of the bone's mesh), sign by
  * angle-weighted pseudo-normals, a coarse grid per bone that rejects far
