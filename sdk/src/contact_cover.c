@@ -369,10 +369,17 @@ static void cover_item(void *ctx, size_t item)
             }
         }
         for (size_t t = fb; t < fe; t++)
-            lifted += l->lift[t] > 0.0f;
+            if (l->lift[t] > 0.0f)
+                l->lifted_tris[cb * POSE__COVER_CLUSTER + lifted++] = (uint32_t)t; /* item_lifts */
     }
     l->lifted[item] = lifted;
     l->tested[item] = tested;
+}
+
+/* Item `item`'s lifted triangles (l->lifted[item] of them, ascending). */
+static const uint32_t *item_lifts(const pose__cover *l, size_t item)
+{
+    return l->lifted_tris + pose__part_begin(l->cluster_count, (unsigned)item, POSE__COVER_ITEMS) * POSE__COVER_CLUSTER;
 }
 
 /* The lifts, serially in triangle order: each skin vertex moves along the
@@ -381,24 +388,26 @@ static void cover_item(void *ctx, size_t item)
 static void apply_lifts(pose_state *st, pose__cover *l)
 {
     size_t touched = 0;
-    for (size_t t = 0; t < l->tri_count; t++) {
-        if (!(l->lift[t] > 0.0f))
-            continue;
-        const uint32_t *v = l->tris + 3 * t;
-        float n[3];
-        if (!unit_normal(st->tissue_positions + 3 * (size_t)l->skin_vertex[v[0]],
-                         st->tissue_positions + 3 * (size_t)l->skin_vertex[v[1]],
-                         st->tissue_positions + 3 * (size_t)l->skin_vertex[v[2]], n))
-            continue;
-        for (int i = 0; i < 3; i++) {
-            float *a = l->acc + 4 * (size_t)v[i];
-            if (!(a[3] < 0.0f)) { /* first lift of this vertex: -1 marks it */
-                l->touched[touched++] = v[i];
-                a[0] = a[1] = a[2] = 0.0f;
-                a[3] = -1.0f;
+    for (size_t item = 0; item < POSE__COVER_ITEMS; item++) { /* item by item: triangle order */
+        const uint32_t *list = item_lifts(l, item);
+        for (size_t k = 0; k < l->lifted[item]; k++) {
+            const size_t t = list[k];
+            const uint32_t *v = l->tris + 3 * t;
+            float n[3];
+            if (!unit_normal(st->tissue_positions + 3 * (size_t)l->skin_vertex[v[0]],
+                             st->tissue_positions + 3 * (size_t)l->skin_vertex[v[1]],
+                             st->tissue_positions + 3 * (size_t)l->skin_vertex[v[2]], n))
+                continue;
+            for (int i = 0; i < 3; i++) {
+                float *a = l->acc + 4 * (size_t)v[i];
+                if (!(a[3] < 0.0f)) { /* first lift of this vertex: -1 marks it */
+                    l->touched[touched++] = v[i];
+                    a[0] = a[1] = a[2] = 0.0f;
+                    a[3] = -1.0f;
+                }
+                for (int d = 0; d < 3; d++)
+                    a[d] += l->lift[t] * n[d];
             }
-            for (int d = 0; d < 3; d++)
-                a[d] += l->lift[t] * n[d];
         }
     }
     /* Per touched vertex: its direction, then the most its triangles need
@@ -438,7 +447,11 @@ static void apply_lifts(pose_state *st, pose__cover *l)
             moved++;
         }
     }
-    memset(l->lift, 0, l->tri_count * sizeof *l->lift);
+    for (size_t item = 0; item < POSE__COVER_ITEMS; item++) { /* the other lifts are 0 */
+        const uint32_t *list = item_lifts(l, item);
+        for (size_t k = 0; k < l->lifted[item]; k++)
+            l->lift[list[k]] = 0.0f;
+    }
     l->touched_count = touched;
     l->moved = moved;
     l->max_move = most;

@@ -93,6 +93,9 @@ typedef struct pose__cover {
     pose__bvh skin;          /**< over the skin's triangles, refitted each frame */
     uint32_t *skin_tris;     /**< the skin tree's triangles (indices into all tissue vertices) */
     float *lift;             /**< per triangle: this frame's lift (0: none) */
+    uint32_t *lifted_tris;   /**< this frame's lifted triangles, ascending, item by item: an
+                                  item's from the first triangle of its first cluster on
+                                  (lifted[item] of them) */
     float *acc;              /**< 4 per skin vertex: lift-weighted normal sum, its move */
     uint32_t *touched;       /**< skin vertices with a lift this frame */
     size_t touched_count;

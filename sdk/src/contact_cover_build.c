@@ -323,6 +323,7 @@ void pose__cover_release(pose__cover *l, const pose_allocator *a)
     pose__bvh_release(&l->skin, a);
     pose__free(a, l->skin_tris);
     pose__free(a, l->lift);
+    pose__free(a, l->lifted_tris);
     pose__free(a, l->acc);
     pose__free(a, l->touched);
     pose__free(a, l->order_vertex);
@@ -457,7 +458,8 @@ pose_status pose__cover_build(pose__cover *l, const pose_state *st, const pose__
         l->lift = pose__calloc(a, (l->tri_count + 1) * sizeof(float), POSE__ALIGN);
         l->acc = pose__calloc(a, (4 * l->vertex_count + 1) * sizeof(float), POSE__ALIGN);
         l->touched = pose__alloc(a, (l->vertex_count + 1) * sizeof(uint32_t), POSE__ALIGN);
-        if (!l->lift || !l->acc || !l->touched)
+        l->lifted_tris = pose__alloc(a, (l->tri_count + 1) * sizeof(uint32_t), POSE__ALIGN);
+        if (!l->lift || !l->acc || !l->touched || !l->lifted_tris)
             s = oom("work arrays");
     }
     if (s == POSE_OK)
