@@ -242,8 +242,10 @@ int pose__bvh_winding(const pose__bvh *t, const float *positions, const float *p
 }
 
 /* The ray p + s d (s >= 0) meets node n's box, grown by a little so that
- * float rounding in the slabs never drops a triangle the exact test counts. */
-static int ray_meets(const pose__bvh_node *n, const float *p, const float *d)
+ * float rounding in the slabs never drops a triangle the exact test counts
+ * (inv: 1 / d per axis, 0 where d is 0: products, not a division per slab:
+ * the pad holds either rounding). */
+static int ray_meets(const pose__bvh_node *n, const float *p, const float *d, const float *inv)
 {
     float t0 = 0.0f, t1 = INFINITY;
     for (int k = 0; k < 3; k++) {
@@ -254,7 +256,7 @@ static int ray_meets(const pose__bvh_node *n, const float *p, const float *d)
                 return 0;
             continue;
         }
-        const float a = lo / d[k], b = hi / d[k];
+        const float a = lo * inv[k], b = hi * inv[k];
         t0 = max2(t0, min2(a, b));
         t1 = min2(t1, max2(a, b));
         if (t0 > t1)
@@ -269,10 +271,15 @@ int pose__bvh_winding_along(const pose__bvh *t, const float *positions, const fl
     int top = 0, w = 0;
     if (!t->node_count)
         return 0;
+    /* a component too small for its reciprocal to be finite counts as 0 */
+    const float dir[3] = {fabsf(d[0]) < 1e-30f ? 0.0f : d[0], fabsf(d[1]) < 1e-30f ? 0.0f : d[1],
+                          fabsf(d[2]) < 1e-30f ? 0.0f : d[2]};
+    const float inv[3] = {dir[0] != 0.0f ? 1.0f / dir[0] : 0.0f, dir[1] != 0.0f ? 1.0f / dir[1] : 0.0f,
+                          dir[2] != 0.0f ? 1.0f / dir[2] : 0.0f};
     stack[top++] = 0;
     while (top > 0) {
         const pose__bvh_node *n = &t->nodes[stack[--top]];
-        if (!ray_meets(n, p, d))
+        if (!ray_meets(n, p, dir, inv))
             continue;
         if (!n->count) {
             stack[top++] = n->first;
