@@ -207,8 +207,9 @@ static pose_status bone_gap(pose__push_bone *b, const uint8_t *cells, uint32_t *
     while (head < tail) {
         const size_t i = queue[head++];
         const int x = (int)(i % sy), y = (int)((i / sy) % (size_t)b->dim[1]), z = (int)(i / sz);
-        /* POSE__CELL_OUT + gap of the neighbours: a non-OUT cell's have gap 1. */
-        const int next = (code[i] < POSE__CELL_OUT ? POSE__CELL_OUT : code[i]) + 1;
+        /* POSE__CELL_OUT - 1 + gap of the neighbours: a non-OUT cell's have
+         * gap 1 (code POSE__CELL_OUT), an OUT cell's one more than its own. */
+        const int next = code[i] < POSE__CELL_OUT ? POSE__CELL_OUT : code[i] + 1;
         if (next >= 255)
             continue;
         for (int dz = -1; dz <= 1; dz++)
