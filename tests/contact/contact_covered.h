@@ -18,25 +18,32 @@
 
 #define CONTACT_COVERED_REACH 0.04
 
+/* Whether p lies inside the bone mesh x (the triangles of ti): crossings of
+ * rays along +x and -x both positive, as pose_contact_detect counts (a few
+ * bone meshes are open). */
+static inline int contact_inside_mesh(const pose_tissue_info *ti, const float *x, const float *p)
+{
+    static const float minus_x[3] = {-1.0f, 0.0f, 0.0f};
+    int w = 0, w2 = 0;
+    for (size_t f = 0; f < ti->triangle_count; f++) {
+        const uint32_t *t = ti->triangles + 3 * f;
+        const float *u = x + 3 * (size_t)t[0], *v = x + 3 * (size_t)t[1], *q = x + 3 * (size_t)t[2];
+        w += pose__ray_x_crossing(p, u, v, q);
+        w2 += pose__ray_crossing(p, minus_x, u, v, q);
+    }
+    return w > 0 && w2 > 0;
+}
+
 /* Whether p (posed) lies inside one of the bones (tissue indices) that
  * lies within the reach of rest_p at rest. -1: a tissue could not be read. */
 static inline int contact_in_covered_bone(const pose_rig *rig, const pose_state *st, const int *bones,
                                           int bone_count, const float *rest_p, const float *p)
 {
-    static const float minus_x[3] = {-1.0f, 0.0f, 0.0f};
     for (int i = 0; i < bone_count; i++) {
         pose_tissue_info ti;
         if (pose_rig_tissue_info(rig, bones[i], &ti) != POSE_OK)
             return -1;
-        const float *x = pose_tissue_positions(st, bones[i], NULL);
-        int w = 0, w2 = 0;
-        for (size_t f = 0; f < ti.triangle_count; f++) {
-            const uint32_t *t = ti.triangles + 3 * f;
-            const float *u = x + 3 * (size_t)t[0], *v = x + 3 * (size_t)t[1], *q = x + 3 * (size_t)t[2];
-            w += pose__ray_x_crossing(p, u, v, q);
-            w2 += pose__ray_crossing(p, minus_x, u, v, q);
-        }
-        if (w <= 0 || w2 <= 0)
+        if (!contact_inside_mesh(&ti, pose_tissue_positions(st, bones[i], NULL), p))
             continue;
         const float *r = ti.rest_positions;
         for (size_t f = 0; f < ti.triangle_count; f++) {

@@ -64,21 +64,6 @@ typedef struct body {
 
 static body g;
 
-/* Whether p lies inside the bone mesh x (triangles of ti): crossings of
- * rays along +x and -x both odd-positive. */
-static int inside_bone(const pose_tissue_info *ti, const float *x, const float *p)
-{
-    static const float minus_x[3] = {-1.0f, 0.0f, 0.0f};
-    int w = 0, w2 = 0;
-    for (size_t f = 0; f < ti->triangle_count; f++) {
-        const uint32_t *t = ti->triangles + 3 * f;
-        const float *u = x + 3 * (size_t)t[0], *v = x + 3 * (size_t)t[1], *q = x + 3 * (size_t)t[2];
-        w += pose__ray_x_crossing(p, u, v, q);
-        w2 += pose__ray_crossing(p, minus_x, u, v, q);
-    }
-    return w > 0 && w2 > 0;
-}
-
 /* Soft nodes at `nodes` (3 per tet vertex) inside a posed bone (`st`'s
  * bone tissues; NULL: at rest); flags into `in` when given. */
 static size_t count_nodes(const pose_state *st, const float *nodes, uint8_t *in)
@@ -101,7 +86,7 @@ static size_t count_nodes(const pose_state *st, const float *nodes, uint8_t *in)
             if (!g.soft[v] || (in && in[v]) || (!in && g.rest_in[v]) || p[0] < lo[0] || p[1] < lo[1] ||
                 p[2] < lo[2] || p[0] > hi[0] || p[1] > hi[1] || p[2] > hi[2])
                 continue;
-            if (inside_bone(&ti, x, p)) {
+            if (contact_inside_mesh(&ti, x, p)) {
                 count++;
                 if (in)
                     in[v] = 1;

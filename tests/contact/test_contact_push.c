@@ -63,15 +63,7 @@ static double bone_depth(const body *b, const pose_state *st, const float *p)
         pose_tissue_info ti;
         assert_int_equal(pose_rig_tissue_info(b->rig, b->bones[i], &ti), POSE_OK);
         const float *x = pose_tissue_positions(st, b->bones[i], NULL);
-        static const float minus_x[3] = {-1.0f, 0.0f, 0.0f};
-        int w = 0, w2 = 0;
-        for (size_t f = 0; f < ti.triangle_count; f++) {
-            const uint32_t *t = ti.triangles + 3 * f;
-            const float *u = x + 3 * (size_t)t[0], *v = x + 3 * (size_t)t[1], *q = x + 3 * (size_t)t[2];
-            w += pose__ray_x_crossing(p, u, v, q);
-            w2 += pose__ray_crossing(p, minus_x, u, v, q);
-        }
-        if (w <= 0 || w2 <= 0)
+        if (!contact_inside_mesh(&ti, x, p))
             continue;
         double d = INFINITY;
         for (size_t f = 0; f < ti.triangle_count; f++) {
