@@ -2,7 +2,7 @@
  * Compiled into every program that links pose_preprocess in a ThreadSanitizer
  * build (-DPOSE_TSAN=ON): pose-bake, the tests and fixtures that bake.
  * CHOLMOD's supernodal factorisation runs OpenMP threads (libgomp, not
- * instrumented): TSan sees a worker's memset of CHOLMOD's workspace but not
+ * instrumented), and its BLAS may run threads of its own (below): TSan sees a worker's memset of CHOLMOD's workspace but not
  * the OpenMP barrier that orders it before the main thread's next use, in
  * these two CHOLMOD functions, nor the fork that hands a fresh workspace from
  * cholmod_malloc on the main thread to the worker that clears it (the
@@ -22,5 +22,10 @@ __attribute__((visibility("default"))) const char *__tsan_default_suppressions(v
            /* The same hand-offs where TSan could not restore the main thread's
             * stack: the only frame left to name is the worker's, in libgomp
             * (which pose's own code never calls: its threads are pthreads). */
-           "race:libgomp.so.1\n";
+           "race:libgomp.so.1\n"
+           /* Where the BLAS is OpenBLAS built with its own pthreads
+            * (libopenblas0-pthread, which apt may pick for libblas.so.3):
+            * CHOLMOD's dense updates run in its workers, whose hand-offs TSan
+            * cannot see either (uninstrumented, no symbols past the kernel). */
+           "race:libopenblas.so.0\n";
 }
