@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0
  * CMU clips retargeted onto a body baked by pose-bake from data/anatomy with
- * preprocess/templates/full_body.json (fixture bridge_body_bake writes
+ * preprocess/templates/full_body.json (fixture body_rig_bake writes
  * $POSE_TEST_TMP/body.rig): the rig's real rest frames, neutral posture and
  * clinical ranges, as the demo uses them. Every frame goes through libpose
  * (pose_set_joint, so with its clamping) on a state given the map's ranges
@@ -108,7 +108,7 @@ static int setup(void **state)
     static fixture f;
     char p[1024];
     if (pose_rig_load(BT_TMP(p, "body.rig"), &f.rig) < 0) {
-        print_error("%s (written by the ctest fixture bridge_body_bake)\n", pose_last_error());
+        print_error("%s (written by the ctest fixture body_rig_bake)\n", pose_last_error());
         return -1;
     }
     pb_error err;

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0
  * The bundled device recordings pose a body baked from data/anatomy the way
- * the mannequin stands (fixture bridge_body_bake writes $POSE_TEST_TMP/body.rig).
+ * the mannequin stands (fixture body_rig_bake writes $POSE_TEST_TMP/body.rig).
  * The goniometers read clinical angles, 0 in the anatomical neutral posture;
  * the shipped maps (bridge/maps/hid_mannequin_full_body.json,
  * can_rig_fullbody.json) drive the rig's clinical angles, which libpose
@@ -52,7 +52,7 @@ static int setup(void **state)
     static fixture f;
     char p[1024];
     if (pose_rig_load(BT_TMP(p, "body.rig"), &f.rig) < 0) {
-        print_error("%s (written by the ctest fixture bridge_body_bake)\n", pose_last_error());
+        print_error("%s (written by the ctest fixture body_rig_bake)\n", pose_last_error());
         return -1;
     }
     pb_error err;

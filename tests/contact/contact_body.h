@@ -35,6 +35,16 @@ static inline size_t contact_pose_count(void)
     return n > 0 && (size_t)n < CONTACT_POSE_COUNT ? (size_t)n : CONTACT_POSE_COUNT;
 }
 
+/* $POSE_CONTACT_THREADS_ONLY set (the TSan stage): a test keeps to what
+ * the threads do, 1 thread against 2, and leaves out its single-threaded
+ * brute-force references and sweeps, which take minutes under TSan and
+ * check values the other stages check. */
+static inline int contact_threads_only(void)
+{
+    const char *e = getenv("POSE_CONTACT_THREADS_ONLY");
+    return e && *e && *e != '0';
+}
+
 /* Set pose `p` on `st` (from a reset). 0, or -1 naming nothing: a joint is
  * missing or the state refused the angles. */
 static inline int contact_pose_set(const pose_rig *rig, pose_state *st, const contact_pose *p)

@@ -453,12 +453,55 @@ static void continuous_in_a_sweep(void **unused)
     pose_rig_free(rig);
 }
 
+/* The push on 1 and 2 threads gives the same bits, LBS and DQS, at each
+ * pose (what the TSan stage runs: contact_threads_only). */
+static void threads_agree(void **unused)
+{
+    (void)unused;
+    pose_rig *rig;
+    if (pose_rig_load(getenv("POSE_CONTACT_RIG"), &rig) != POSE_OK)
+        fail_msg("%s", pose_last_error());
+    pose_state *st[2];
+    for (int k = 0; k < 2; k++) {
+        pose_state_options so = {.size = sizeof so, .threads = k + 1};
+        assert_int_equal(pose_state_create_ex(rig, &so, &st[k]), POSE_OK);
+        set_response(st[k], 1);
+    }
+    const pose_method methods[] = {POSE_LBS, POSE_DQS};
+    for (size_t m = 0; m < 2; m++)
+        for (size_t c = 0; c < contact_pose_count(); c++) {
+            pose_contact_response_stats rs[2] = {{.size = sizeof rs[0]}, {.size = sizeof rs[1]}};
+            for (int k = 0; k < 2; k++) {
+                assert_int_equal(contact_pose_set(rig, st[k], &contact_poses[c]), 0);
+                assert_int_equal(pose_set_method(st[k], methods[m]), POSE_OK);
+                assert_int_equal(pose_apply(st[k]), POSE_OK);
+                assert_int_equal(pose_get_contact_response_stats(st[k], &rs[k]), POSE_OK);
+            }
+            assert_true(rs[0].pushed > 0);
+            assert_int_equal(rs[1].pushed, rs[0].pushed);
+            for (int t = 0; t < (int)pose_rig_tissue_count(rig); t++) {
+                size_t n;
+                const float *a = pose_tissue_positions(st[0], t, &n), *b = pose_tissue_positions(st[1], t, NULL);
+                assert_memory_equal(a, b, 3 * n * sizeof(float));
+            }
+        }
+    pose_state_free(st[0]);
+    pose_state_free(st[1]);
+    pose_rig_free(rig);
+}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {
+    const struct CMUnitTest all[] = {
         cmocka_unit_test(invalid_settings),
+        cmocka_unit_test(threads_agree),
         cmocka_unit_test(skin_out_of_bone),
         cmocka_unit_test(continuous_in_a_sweep),
     };
-    return cmocka_run_group_tests(tests, NULL, NULL);
+    const struct CMUnitTest threads[] = {
+        cmocka_unit_test(threads_agree),
+    };
+    if (contact_threads_only())
+        return cmocka_run_group_tests(threads, NULL, NULL);
+    return cmocka_run_group_tests(all, NULL, NULL);
 }

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: Apache-2.0
  * The reference USB goniometer box's captures through the public API
  * (pose/bridge.h) pose the body baked from data/anatomy (fixture
- * bridge_body_bake) as the capture's truth file says: every true angle,
+ * body_rig_bake) as the capture's truth file says: every true angle,
  * measured back from the posed joint's world rotation in the clinical
  * convention, within 2 degrees wherever the rig's range of motion does not
  * limit it (as tests/bridge/test_device_posture.c checks the HID mannequin
@@ -43,7 +43,7 @@ static int setup(void **state)
     static fixture f;
     char p[1024];
     if (pose_rig_load(path(p, sizeof p, "POSE_TEST_TMP", "body.rig"), &f.rig) < 0) {
-        print_error("%s (written by the ctest fixture bridge_body_bake)\n", pose_last_error());
+        print_error("%s (written by the ctest fixture body_rig_bake)\n", pose_last_error());
         return -1;
     }
     if (pose_state_create(f.rig, &f.st) != POSE_OK)
