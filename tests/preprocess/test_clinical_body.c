@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0
  * Clinical angles through libpose on a body baked by pose-bake from the
- * bundled anatomy (the pp_clinical_body_bake fixture, argv[1]): the rig
+ * bundled anatomy (the shared body_rig_bake fixture, argv[1]): the rig
  * carries the bake's neutral posture and axes, and pose_set_neutral /
  * pose_set_joint_clinical pose it the way a goniometer reads: limbs hanging,
  * palms to the thighs, abduction 90 the T-pose, flexion forward and up,
