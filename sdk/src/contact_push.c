@@ -19,15 +19,17 @@
 void pose__state_push_frames(pose_state *st)
 {
     pose__push *p = st->push;
+    const size_t stride = 64 * p->bone_words;
     for (size_t j = 0; j < p->bone_count; j++) {
         const pose__push_bone *b = &p->bones[j];
         const pose__xform *m = &st->skin[b->joint];
-        float *f = p->frames + 12 * j, *s = p->bone_spheres + 4 * j;
+        float *f = p->frames + 12 * j;
         pose__quat_to_matrix(m->q, f);
         memcpy(f + 9, m->t, 3 * sizeof(float));
         for (int r = 0; r < 3; r++)
-            s[r] = f[3 * r] * b->center[0] + f[3 * r + 1] * b->center[1] + f[3 * r + 2] * b->center[2] + f[9 + r];
-        s[3] = b->radius;
+            p->bone_spheres[(size_t)r * stride + j] =
+                f[3 * r] * b->center[0] + f[3 * r + 1] * b->center[1] + f[3 * r + 2] * b->center[2] + f[9 + r];
+        p->bone_spheres[3 * stride + j] = b->radius;
     }
 }
 
@@ -227,13 +229,33 @@ int pose__push_sphere_near(const pose__push_bone *b, const float *f, const float
     return !(gap > 1 && ((float)gap - 1.0f) * b->cell > reach);
 }
 
-int pose__push_cluster_near(const pose__push *p, size_t j, const float *cluster)
+/* Whether bone j's posed sphere comes within the margin of sphere c. */
+static inline int spheres_near(const pose__push *p, size_t j, const float *c)
 {
-    const float *s = p->bone_spheres + 4 * j;
-    const float dx = cluster[0] - s[0], dy = cluster[1] - s[1], dz = cluster[2] - s[2];
-    const float reach = cluster[3] + s[3] + p->margin;
-    return dx * dx + dy * dy + dz * dz <= reach * reach &&
-           pose__push_sphere_near(&p->bones[j], p->frames + 12 * j, cluster, 0);
+    const size_t stride = 64 * p->bone_words;
+    const float *s = p->bone_spheres + j;
+    const float dx = c[0] - s[0], dy = c[1] - s[stride], dz = c[2] - s[2 * stride];
+    const float reach = c[3] + s[3 * stride] + p->margin;
+    return dx * dx + dy * dy + dz * dz <= reach * reach;
+}
+
+void pose__push_near_bones(const pose__push *p, const float *cluster, const uint64_t *mask, uint64_t *near)
+{
+    for (size_t w = 0; w < p->bone_words; w++) {
+        uint64_t bits = 0;
+        if (mask) { /* the few bones it marks */
+            for (uint64_t m = mask[w]; m; m &= m - 1)
+                if (spheres_near(p, POSE__PUSH_BIT(w, m), cluster))
+                    bits |= m & -m;
+        } else { /* all: 64 side by side (no branch), then their bits */
+            uint8_t hit[64];
+            for (size_t k = 0; k < 64; k++)
+                hit[k] = (uint8_t)spheres_near(p, 64 * w + k, cluster);
+            for (size_t k = 0; k < 64; k++)
+                bits |= (uint64_t)hit[k] << k;
+        }
+        near[w] = bits;
+    }
 }
 
 /* Clusters split into items: each vertex is moved by one item, bone after
@@ -264,33 +286,36 @@ void pose__state_push_item(void *ctx, size_t item)
          * another stays there rather than move by more than its depth. (A
          * vertex not yet pushed has not moved: the spheres hold it.) */
         uint8_t done[POSE__PUSH_CLUSTER] = {0};
-        const uint8_t *reach = p->reach + c * p->reach_stride;
-        for (size_t j = 0; j < p->bone_count; j++) {
-            if (!(reach[j / 8] >> (j % 8) & 1u) || !pose__push_cluster_near(p, j, cluster))
-                continue;
-            const pose__push_bone *b = &p->bones[j];
-            const float *f = p->frames + 12 * j;
-            for (size_t g = 0; g < groups; g++) {
-                if (!pose__push_sphere_near(b, f, group[g], 0))
+        uint64_t *near = p->near + item * p->bone_words;
+        pose__push_near_bones(p, cluster, p->reach + c * p->bone_words, near);
+        for (size_t w = 0; w < p->bone_words; w++)
+            for (uint64_t bits = near[w]; bits; bits &= bits - 1) {
+                const size_t j = POSE__PUSH_BIT(w, bits);
+                const pose__push_bone *b = &p->bones[j];
+                const float *f = p->frames + 12 * j;
+                if (!pose__push_sphere_near(b, f, cluster, 0))
                     continue;
-                const size_t gb = vb + g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < ve ? gb + POSE__PUSH_GROUP : ve;
-                for (size_t i = gb; i < ge; i++) {
-                    if (p->skip[i] || done[i - vb] || p->own_joint[i] == b->joint)
+                for (size_t g = 0; g < groups; g++) {
+                    if (!pose__push_sphere_near(b, f, group[g], 0))
                         continue;
-                    float *x = st->tissue_positions + 3 * (size_t)p->order[i], before[3];
-                    memcpy(before, x, sizeof before);
-                    float m = push_vertex(p, b, f, x, &p->cache[i]);
-                    done[i - vb] = m > 0.0f;
-                    if (m > 0.0f) {
-                        /* lifted first: counted by the cover, its whole move here */
-                        const float whole = pose__cover_bound(p, b, f, i, before, x);
-                        pushed += !(whole >= 0.0f);
-                        m = whole >= 0.0f ? whole : m;
+                    const size_t gb = vb + g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < ve ? gb + POSE__PUSH_GROUP : ve;
+                    for (size_t i = gb; i < ge; i++) {
+                        if (p->skip[i] || done[i - vb] || p->own_joint[i] == b->joint)
+                            continue;
+                        float *x = st->tissue_positions + 3 * (size_t)p->order[i], before[3];
+                        memcpy(before, x, sizeof before);
+                        float m = push_vertex(p, b, f, x, &p->cache[i]);
+                        done[i - vb] = m > 0.0f;
+                        if (m > 0.0f) {
+                            /* lifted first: counted by the cover, its whole move here */
+                            const float whole = pose__cover_bound(p, b, f, i, before, x);
+                            pushed += !(whole >= 0.0f);
+                            m = whole >= 0.0f ? whole : m;
+                        }
+                        most = m > most ? m : most;
                     }
-                    most = m > most ? m : most;
                 }
             }
-        }
     }
     p->pushed[item] = pushed;
     p->max_push[item] = most;

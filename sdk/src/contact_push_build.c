@@ -426,8 +426,7 @@ static void mark_rest_inside(pose__push *p, const pose_state *st)
 /* Which bones each cluster of skin covers at rest (pose__push.reach). */
 static pose_status mark_reach(pose__push *p, const pose_state *st)
 {
-    p->reach_stride = (p->bone_count + 7) / 8;
-    p->reach = pose__calloc(&p->allocator, p->cluster_count * p->reach_stride + 1, POSE__ALIGN);
+    p->reach = pose__calloc(&p->allocator, (p->cluster_count * p->bone_words + 1) * sizeof *p->reach, POSE__ALIGN);
     float *rest = pose__alloc(&p->allocator, (3 * p->vertex_count + 1) * sizeof(float), POSE__ALIGN);
     if (!p->reach || !rest) {
         pose__free(&p->allocator, rest);
@@ -454,7 +453,7 @@ static pose_status mark_reach(pose__push *p, const pose_state *st)
                 e2 += e * e;
             }
             if (e2 <= reach * reach && pose__push_distance(b, sphere, reach, q, o) <= reach)
-                p->reach[c * p->reach_stride + j / 8] |= (uint8_t)(1u << (j % 8));
+                p->reach[c * p->bone_words + j / 64] |= (uint64_t)1 << (j % 64);
         }
     }
     pose__free(&p->allocator, rest);
@@ -533,6 +532,7 @@ void pose__push_release(pose__push *p)
     pose__free(a, p->reach);
     pose__free(a, p->frames);
     pose__free(a, p->bone_spheres);
+    pose__free(a, p->near);
     pose__free(a, p->nodes);
     pose__free(a, p->node_cache);
     pose__free(a, p->node_bone);
@@ -561,9 +561,13 @@ pose_status pose__push_build(pose__push *p, const pose_state *st, float margin)
               rig->tissues[t].triangle_count > 0;
     p->bones = pose__calloc(&p->allocator, (nb + 1) * sizeof *p->bones, POSE__ALIGN);
     p->frames = pose__alloc(&p->allocator, (nb + 1) * 12 * sizeof(float), POSE__ALIGN);
-    p->bone_spheres = pose__alloc(&p->allocator, (nb + 1) * 4 * sizeof(float), POSE__ALIGN);
-    if (!p->bones || !p->frames || !p->bone_spheres)
+    p->bone_words = (nb + 63) / 64;
+    p->bone_spheres = pose__alloc(&p->allocator, (4 * 64 * p->bone_words + 1) * sizeof(float), POSE__ALIGN);
+    p->near = pose__alloc(&p->allocator, (POSE__PUSH_ITEMS * p->bone_words + 1) * sizeof *p->near, POSE__ALIGN);
+    if (!p->bones || !p->frames || !p->bone_spheres || !p->near)
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu bones", nb);
+    for (size_t j = 0; j < 4 * 64 * p->bone_words; j++) /* the padding never near (x infinite) */
+        p->bone_spheres[j] = j < 64 * p->bone_words ? INFINITY : 0.0f;
     pose_status s = POSE_OK;
     for (size_t t = 0; t < rig->tissue_count && s == POSE_OK; t++) {
         const pose__tissue *ts = &rig->tissues[t];
