@@ -22,30 +22,37 @@ static const float *vertex(const float *positions, uint32_t v)
     return positions + 3 * (size_t)v;
 }
 
+/* Box b (lo x, y, z, hi x, y, z) grown to hold x; the axes written out:
+ * loops over them were not unrolled. */
+static inline void grow(float *b, const float *x)
+{
+    b[0] = min2(b[0], x[0]);
+    b[1] = min2(b[1], x[1]);
+    b[2] = min2(b[2], x[2]);
+    b[3] = max2(b[3], x[0]);
+    b[4] = max2(b[4], x[1]);
+    b[5] = max2(b[5], x[2]);
+}
+
 void pose__bvh_refit_leaves(pose__bvh *t, const float *positions, size_t begin, size_t end)
 {
     for (size_t l = begin; l < end; l++) {
         pose__bvh_node *n = &t->nodes[t->leaves[l]];
-        /* the axes written out: the loops over them were not unrolled */
-        float lx = INFINITY, ly = INFINITY, lz = INFINITY, hx = -INFINITY, hy = -INFINITY, hz = -INFINITY;
-        for (uint32_t i = n->first; i < n->first + n->count; i++) {
-            const uint32_t *tri = t->triangles + 3 * (size_t)t->items[i];
-            for (int k = 0; k < 3; k++) {
-                const float *x = vertex(positions, tri[k]);
-                lx = min2(lx, x[0]);
-                ly = min2(ly, x[1]);
-                lz = min2(lz, x[2]);
-                hx = max2(hx, x[0]);
-                hy = max2(hy, x[1]);
-                hz = max2(hz, x[2]);
+        float b[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+        if (t->corners) {
+            for (uint32_t i = t->corner_begin[l]; i < t->corner_begin[l + 1]; i++)
+                grow(b, vertex(positions, t->corners[i]));
+        } else {
+            for (uint32_t i = n->first; i < n->first + n->count; i++) {
+                const uint32_t *tri = t->triangles + 3 * (size_t)t->items[i];
+                for (int k = 0; k < 3; k++)
+                    grow(b, vertex(positions, tri[k]));
             }
         }
-        n->lo[0] = lx;
-        n->lo[1] = ly;
-        n->lo[2] = lz;
-        n->hi[0] = hx;
-        n->hi[1] = hy;
-        n->hi[2] = hz;
+        for (int d = 0; d < 3; d++) {
+            n->lo[d] = b[d];
+            n->hi[d] = b[3 + d];
+        }
     }
 }
 

@@ -33,6 +33,10 @@ typedef struct pose__bvh {
     uint32_t *items;           /**< triangle ids, leaf by leaf */
     uint32_t *leaves;          /**< the leaf nodes' indices (refit splits them by part) */
     uint32_t leaf_count;
+    /** Optional (pose__bvh_index_corners): each leaf's triangles' distinct
+     *  corners, leaf k's from corners[corner_begin[k]] to corners[corner_begin[k + 1]],
+     *  so that the refit reads each vertex once; NULL: it reads triangles. */
+    uint32_t *corner_begin, *corners;
     /** Self-intersection work split for threads: task i < split_pairs is
      *  the pair (children of inner node split_nodes[i]); the rest are the
      *  subtrees split_nodes[i] tested against themselves. Together they
@@ -41,7 +45,8 @@ typedef struct pose__bvh {
     uint32_t split_pairs, split_count;
 } pose__bvh;
 
-/** Boxes of the leaves [begin, end) of leaves[] around the posed vertices. */
+/** Boxes of the leaves [begin, end) of leaves[] around the posed vertices
+ *  (their distinct corners, where the tree has them). */
 void pose__bvh_refit_leaves(pose__bvh *t, const float *positions, size_t begin, size_t end);
 /** Boxes of the inner nodes from their children (after every leaf). */
 void pose__bvh_refit_inner(pose__bvh *t);

@@ -127,6 +127,10 @@ static pose_status build(pose_contact *c, unsigned threads)
     s = pose__bvh_build(&c->skin, &c->allocator, c->skin_tris, skin_tri_count, rest);
     if (s == POSE_OK)
         s = pose__bvh_build(&c->bone, &c->allocator, c->bone_tris, bone_tri_count, rest);
+    if (s == POSE_OK) /* each refit reads a vertex once */
+        s = pose__bvh_index_corners(&c->skin, &c->allocator);
+    if (s == POSE_OK)
+        s = pose__bvh_index_corners(&c->bone, &c->allocator);
     pose__free(&c->allocator, rest);
     if (s != POSE_OK)
         return s;

@@ -71,7 +71,42 @@ void pose__bvh_release(pose__bvh *t, const pose_allocator *a)
     pose__free(a, t->items);
     pose__free(a, t->leaves);
     pose__free(a, t->split_nodes);
+    pose__free(a, t->corner_begin);
+    pose__free(a, t->corners);
     memset(t, 0, sizeof *t);
+}
+
+pose_status pose__bvh_index_corners(pose__bvh *t, const pose_allocator *a)
+{
+    uint32_t *begin = pose__alloc(a, ((size_t)t->leaf_count + 1) * sizeof *begin, POSE__ALIGN), triangles = 0;
+    for (uint32_t k = 0; k < t->leaf_count; k++)
+        triangles += t->nodes[t->leaves[k]].count;
+    uint32_t *corners = pose__alloc(a, (3 * (size_t)triangles + 1) * sizeof *corners, POSE__ALIGN);
+    if (!begin || !corners) {
+        pose__free(a, begin);
+        pose__free(a, corners);
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for a BVH's corners (%u triangles)", triangles);
+    }
+    uint32_t n = 0;
+    for (uint32_t k = 0; k < t->leaf_count; k++) {
+        const pose__bvh_node *leaf = &t->nodes[t->leaves[k]];
+        begin[k] = n;
+        for (uint32_t i = leaf->first; i < leaf->first + leaf->count; i++)
+            for (int c = 0; c < 3; c++) { /* a leaf holds a few triangles: a linear search */
+                const uint32_t v = t->triangles[3 * (size_t)t->items[i] + (size_t)c];
+                uint32_t seen = begin[k];
+                while (seen < n && corners[seen] != v)
+                    seen++;
+                if (seen == n)
+                    corners[n++] = v;
+            }
+    }
+    begin[t->leaf_count] = n;
+    pose__free(a, t->corner_begin);
+    pose__free(a, t->corners);
+    t->corner_begin = begin;
+    t->corners = corners;
+    return POSE_OK;
 }
 
 pose_status pose__bvh_build(pose__bvh *t, const pose_allocator *a, const uint32_t *triangles,

@@ -11,7 +11,12 @@
  *  POSE_OK or POSE_ERR_OUT_OF_MEMORY (then nothing is left allocated). */
 pose_status pose__bvh_build(pose__bvh *t, const pose_allocator *a, const uint32_t *triangles,
                             uint32_t count, const float *positions);
-/** Free what pose__bvh_build allocated (a zeroed tree is fine). */
+/** Each leaf's distinct corners (pose__bvh.corners) from the tree's
+ *  triangles as they are now: the refit then reads each vertex once.
+ *  POSE_OK or POSE_ERR_OUT_OF_MEMORY (the tree unchanged). */
+pose_status pose__bvh_index_corners(pose__bvh *t, const pose_allocator *a);
+/** Free what pose__bvh_build and pose__bvh_index_corners allocated (a
+ *  zeroed tree is fine). */
 void pose__bvh_release(pose__bvh *t, const pose_allocator *a);
 
 #endif /* POSE_CONTACT_BUILD_H */

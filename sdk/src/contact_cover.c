@@ -493,34 +493,13 @@ void pose__cover_finish(pose__cover *l)
     l->touched_count = 0;
 }
 
-/* The skin tree's leaves, item by item (each box from its own triangles'
- * distinct corners: the boxes pose__bvh_refit_leaves makes). */
+/* The skin tree's leaves, item by item. */
 static void refit_item(void *ctx, size_t item)
 {
     pose_state *st = ctx;
-    pose__cover *l = st->push->cover;
-    const float *x = st->tissue_positions;
-    const size_t lb = pose__part_begin(l->skin.leaf_count, (unsigned)item, COVER_REFIT_ITEMS),
-                 le = pose__part_begin(l->skin.leaf_count, (unsigned)item + 1, COVER_REFIT_ITEMS);
-    for (size_t k = lb; k < le; k++) {
-        pose__bvh_node *n = &l->skin.nodes[l->skin.leaves[k]];
-        float lx = INFINITY, ly = INFINITY, lz = INFINITY, hx = -INFINITY, hy = -INFINITY, hz = -INFINITY;
-        for (uint32_t i = l->leaf_vert_begin[k]; i < l->leaf_vert_begin[k + 1]; i++) {
-            const float *y = x + 3 * (size_t)l->leaf_verts[i];
-            lx = min2(lx, y[0]);
-            ly = min2(ly, y[1]);
-            lz = min2(lz, y[2]);
-            hx = max2(hx, y[0]);
-            hy = max2(hy, y[1]);
-            hz = max2(hz, y[2]);
-        }
-        n->lo[0] = lx;
-        n->lo[1] = ly;
-        n->lo[2] = lz;
-        n->hi[0] = hx;
-        n->hi[1] = hy;
-        n->hi[2] = hz;
-    }
+    pose__bvh *t = &st->push->cover->skin;
+    pose__bvh_refit_leaves(t, st->tissue_positions, pose__part_begin(t->leaf_count, (unsigned)item, COVER_REFIT_ITEMS),
+                           pose__part_begin(t->leaf_count, (unsigned)item + 1, COVER_REFIT_ITEMS));
 }
 
 void pose__state_cover(pose_state *st)

@@ -92,9 +92,6 @@ typedef struct pose__cover {
                                   are weighted to it alone), so it keeps its rest place */
     pose__bvh skin;          /**< over the skin's triangles, refitted each frame */
     uint32_t *skin_tris;     /**< the skin tree's triangles (indices into all tissue vertices) */
-    uint32_t *leaf_vert_begin; /**< the skin tree's leaf_count + 1, into leaf_verts */
-    uint32_t *leaf_verts;    /**< per leaf of the skin tree, its triangles' distinct corners
-                                  (indices into all tissue vertices): the refit reads each once */
     float *lift;             /**< per triangle: this frame's lift (0: none) */
     uint32_t *lifted_tris;   /**< this frame's lifted triangles, ascending, item by item: an
                                   item's from the first triangle of its first cluster on

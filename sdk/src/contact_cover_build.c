@@ -73,28 +73,7 @@ static pose_status skin_tree_posed(cover_build *b)
     for (size_t k = 0; k < 3 * l->tri_count; k++)
         l->skin_tris[k] = l->skin_vertex[b->skin_tris[k]];
     l->skin.triangles = l->skin_tris;
-    /* each leaf's distinct corners, for the refit (each read once) */
-    const pose__bvh *t = &l->skin;
-    l->leaf_vert_begin = pose__alloc(b->a, ((size_t)t->leaf_count + 1) * sizeof(uint32_t), POSE__ALIGN);
-    l->leaf_verts = pose__alloc(b->a, (3 * l->tri_count + 1) * sizeof(uint32_t), POSE__ALIGN);
-    if (!l->leaf_vert_begin || !l->leaf_verts)
-        return oom("skin tree");
-    uint32_t n = 0;
-    for (uint32_t k = 0; k < t->leaf_count; k++) {
-        const pose__bvh_node *leaf = &t->nodes[t->leaves[k]];
-        l->leaf_vert_begin[k] = n;
-        for (uint32_t i = leaf->first; i < leaf->first + leaf->count; i++)
-            for (int c = 0; c < 3; c++) {
-                const uint32_t v = l->skin_tris[3 * (size_t)t->items[i] + (size_t)c];
-                uint32_t seen = l->leaf_vert_begin[k];
-                while (seen < n && l->leaf_verts[seen] != v)
-                    seen++;
-                if (seen == n)
-                    l->leaf_verts[n++] = v;
-            }
-    }
-    l->leaf_vert_begin[t->leaf_count] = n;
-    return POSE_OK;
+    return pose__bvh_index_corners(&l->skin, b->a); /* the refit reads each vertex once */
 }
 
 /* A bone's counted vertices: inside the rest skin (its winding number, as
@@ -343,8 +322,6 @@ void pose__cover_release(pose__cover *l, const pose_allocator *a)
     pose__free(a, l->pair_rigid);
     pose__bvh_release(&l->skin, a);
     pose__free(a, l->skin_tris);
-    pose__free(a, l->leaf_vert_begin);
-    pose__free(a, l->leaf_verts);
     pose__free(a, l->lift);
     pose__free(a, l->lifted_tris);
     pose__free(a, l->acc);

@@ -264,44 +264,41 @@ static void contact_item(void *ctx, size_t item)
             nc[i].count = 0;
             nc[i].depth = 0.0f;
         }
-        uint64_t *near = p->near + item * p->bone_words;
-        pose__push_near_bones(p, cluster, NULL, near);
-        for (size_t w = 0; w < p->bone_words; w++)
-            for (uint64_t bits = near[w]; bits; bits &= bits - 1) {
-                const size_t j = POSE__PUSH_BIT(w, bits);
-                const pose__push_bone *b = &p->bones[j];
-                const float *f = p->frames + 12 * j;
-                if (!pose__push_sphere_near(b, f, cluster, 0))
+        uint32_t *near = p->near + item * p->bone_count;
+        const size_t near_count = pose__push_near_bones(p, cluster, NULL, near);
+        for (size_t kb = 0; kb < near_count; kb++) {
+            const size_t j = near[kb];
+            const pose__push_bone *b = &p->bones[j];
+            const float *f = p->frames + 12 * j;
+            for (size_t g = 0; g < groups; g++) {
+                if (!pose__push_sphere_near(b, f, group[g], 0))
                     continue;
-                for (size_t g = 0; g < groups; g++) {
-                    if (!pose__push_sphere_near(b, f, group[g], 0))
+                const size_t gb = g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < count ? gb + POSE__PUSH_GROUP : count;
+                for (size_t i = gb; i < ge; i++) {
+                    float sd, q[3], out[3];
+                    if (nc[i].count == MAX_CONSTRAINTS ||
+                        !pose__push_query(p, b, f, y[i], &p->node_cache[vb + i], &sd, q, out))
                         continue;
-                    const size_t gb = g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < count ? gb + POSE__PUSH_GROUP : count;
-                    for (size_t i = gb; i < ge; i++) {
-                        float sd, q[3], out[3];
-                        if (nc[i].count == MAX_CONSTRAINTS ||
-                            !pose__push_query(p, b, f, y[i], &p->node_cache[vb + i], &sd, q, out))
-                            continue;
-                        const float plane = p->node_bone[vb + i] == j ? p->node_gap[vb + i] : p->margin;
-                        /* a resting contact holds the node at its plane: the
-                         * constraint only keeps it out of the bone */
-                        const float target = rest_of(p, vb + i, j) ? 0.0f : plane;
-                        if (!(sd < target))
-                            continue;
-                        node_contact *k = &nc[i];
-                        const int r = k->count++;
-                        for (int e = 0; e < 3; e++)
-                            k->n[r][e] = f[3 * e] * out[0] + f[3 * e + 1] * out[1] + f[3 * e + 2] * out[2];
-                        k->c[r] = (target - sd) / dt;
-                        k->bone[r] = (uint16_t)j;
-                        for (int e = 0; e < 3; e++) { /* the plane, should the node rest on it */
-                            k->q[r][e] = q[e] + plane * out[e];
-                            k->out[r][e] = out[e];
-                        }
-                        k->depth = fmaxf(k->depth, -sd);
+                    const float plane = p->node_bone[vb + i] == j ? p->node_gap[vb + i] : p->margin;
+                    /* a resting contact holds the node at its plane: the
+                     * constraint only keeps it out of the bone */
+                    const float target = rest_of(p, vb + i, j) ? 0.0f : plane;
+                    if (!(sd < target))
+                        continue;
+                    node_contact *k = &nc[i];
+                    const int r = k->count++;
+                    for (int e = 0; e < 3; e++)
+                        k->n[r][e] = f[3 * e] * out[0] + f[3 * e + 1] * out[1] + f[3 * e + 2] * out[2];
+                    k->c[r] = (target - sd) / dt;
+                    k->bone[r] = (uint16_t)j;
+                    for (int e = 0; e < 3; e++) { /* the plane, should the node rest on it */
+                        k->q[r][e] = q[e] + plane * out[e];
+                        k->out[r][e] = out[e];
                     }
+                    k->depth = fmaxf(k->depth, -sd);
                 }
             }
+        }
         for (size_t i = 0; i < count; i++) {
             const size_t v = p->nodes[vb + i];
             const float *b = pre + 6 * v, s = (b[0] + b[3] + b[5]) * (1.0f / 3.0f);

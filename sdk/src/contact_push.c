@@ -239,13 +239,14 @@ static inline int spheres_near(const pose__push *p, size_t j, const float *c)
     return dx * dx + dy * dy + dz * dz <= reach * reach;
 }
 
-void pose__push_near_bones(const pose__push *p, const float *cluster, const uint64_t *mask, uint64_t *near)
+size_t pose__push_near_bones(const pose__push *p, const float *cluster, const uint64_t *mask, uint32_t *near)
 {
+    size_t n = 0;
     for (size_t w = 0; w < p->bone_words; w++) {
         uint64_t bits = 0;
         if (mask) { /* the few bones it marks */
             for (uint64_t m = mask[w]; m; m &= m - 1)
-                if (spheres_near(p, POSE__PUSH_BIT(w, m), cluster))
+                if (spheres_near(p, 64 * w + (size_t)__builtin_ctzll(m), cluster))
                     bits |= m & -m;
         } else { /* all: 64 side by side (no branch), then their bits */
             uint8_t hit[64];
@@ -254,8 +255,13 @@ void pose__push_near_bones(const pose__push *p, const float *cluster, const uint
             for (size_t k = 0; k < 64; k++)
                 bits |= (uint64_t)hit[k] << k;
         }
-        near[w] = bits;
+        for (; bits; bits &= bits - 1) {
+            const size_t j = 64 * w + (size_t)__builtin_ctzll(bits);
+            if (pose__push_sphere_near(&p->bones[j], p->frames + 12 * j, cluster, 0))
+                near[n++] = (uint32_t)j;
+        }
     }
+    return n;
 }
 
 /* Clusters split into items: each vertex is moved by one item, bone after
@@ -286,36 +292,32 @@ void pose__state_push_item(void *ctx, size_t item)
          * another stays there rather than move by more than its depth. (A
          * vertex not yet pushed has not moved: the spheres hold it.) */
         uint8_t done[POSE__PUSH_CLUSTER] = {0};
-        uint64_t *near = p->near + item * p->bone_words;
-        pose__push_near_bones(p, cluster, p->reach + c * p->bone_words, near);
-        for (size_t w = 0; w < p->bone_words; w++)
-            for (uint64_t bits = near[w]; bits; bits &= bits - 1) {
-                const size_t j = POSE__PUSH_BIT(w, bits);
-                const pose__push_bone *b = &p->bones[j];
-                const float *f = p->frames + 12 * j;
-                if (!pose__push_sphere_near(b, f, cluster, 0))
+        uint32_t *near = p->near + item * p->bone_count;
+        const size_t near_count = pose__push_near_bones(p, cluster, p->reach + c * p->bone_words, near);
+        for (size_t k = 0; k < near_count; k++) {
+            const pose__push_bone *b = &p->bones[near[k]];
+            const float *f = p->frames + 12 * (size_t)near[k];
+            for (size_t g = 0; g < groups; g++) {
+                if (!pose__push_sphere_near(b, f, group[g], 0))
                     continue;
-                for (size_t g = 0; g < groups; g++) {
-                    if (!pose__push_sphere_near(b, f, group[g], 0))
+                const size_t gb = vb + g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < ve ? gb + POSE__PUSH_GROUP : ve;
+                for (size_t i = gb; i < ge; i++) {
+                    if (p->skip[i] || done[i - vb] || p->own_joint[i] == b->joint)
                         continue;
-                    const size_t gb = vb + g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < ve ? gb + POSE__PUSH_GROUP : ve;
-                    for (size_t i = gb; i < ge; i++) {
-                        if (p->skip[i] || done[i - vb] || p->own_joint[i] == b->joint)
-                            continue;
-                        float *x = st->tissue_positions + 3 * (size_t)p->order[i], before[3];
-                        memcpy(before, x, sizeof before);
-                        float m = push_vertex(p, b, f, x, &p->cache[i]);
-                        done[i - vb] = m > 0.0f;
-                        if (m > 0.0f) {
-                            /* lifted first: counted by the cover, its whole move here */
-                            const float whole = pose__cover_bound(p, b, f, i, before, x);
-                            pushed += !(whole >= 0.0f);
-                            m = whole >= 0.0f ? whole : m;
-                        }
-                        most = m > most ? m : most;
+                    float *x = st->tissue_positions + 3 * (size_t)p->order[i], before[3];
+                    memcpy(before, x, sizeof before);
+                    float m = push_vertex(p, b, f, x, &p->cache[i]);
+                    done[i - vb] = m > 0.0f;
+                    if (m > 0.0f) {
+                        /* lifted first: counted by the cover, its whole move here */
+                        const float whole = pose__cover_bound(p, b, f, i, before, x);
+                        pushed += !(whole >= 0.0f);
+                        m = whole >= 0.0f ? whole : m;
                     }
+                    most = m > most ? m : most;
                 }
             }
+        }
     }
     p->pushed[item] = pushed;
     p->max_push[item] = most;

@@ -111,7 +111,7 @@ typedef struct pose__push {
     float *frames;          /**< per bone per frame: rotation (9, row-major) and translation */
     float *bone_spheres;    /**< per frame, posed: the bones' centres' x, then y, z and radii,
                                  64 bone_words each (padding: x infinite, never near) */
-    uint64_t *near;         /**< per item: scratch for pose__push_near_bones, bone_words words */
+    uint32_t *near;         /**< per item: scratch for pose__push_near_bones, bone_count entries */
     size_t pushed[POSE__PUSH_ITEMS]; /**< per item of the last pass */
     float max_push[POSE__PUSH_ITEMS];
     struct pose__cover *cover; /**< skin lifted over bone before the push (contact_cover.h) */
@@ -171,15 +171,12 @@ void pose__push_sphere(const float *pos, const uint32_t *idx, size_t begin, size
 /** Whether a posed sphere may hold a point bone b (frame f) needs tested
  *  (the grid's gap, per brick unless fine). */
 int pose__push_sphere_near(const pose__push_bone *b, const float *f, const float *sphere, int fine);
-/** The bones whose posed spheres come within the margin of a cluster's
- *  posed bounding sphere, a bit per bone into near (bone_words words); with
- *  mask, only those it marks too. A bone's grid (pose__push_sphere_near)
- *  comes next: the spheres, all bones at once, spare that for most. */
-void pose__push_near_bones(const pose__push *p, const float *cluster, const uint64_t *mask, uint64_t *near);
-/** Bone after bone of a pose__push_near_bones answer, in the rig's order:
- *  for (w = 0; w < words; w++) for (bits = near[w]; bits; bits &= bits - 1)
- *  j = POSE__PUSH_BIT(w, bits). */
-#define POSE__PUSH_BIT(w, bits) (64 * (size_t)(w) + (size_t)__builtin_ctzll(bits))
+/** The bones a cluster's posed bounding sphere may need tested against,
+ *  in the rig's order, into near; their count. With mask (a bit per bone,
+ *  bone_words words), only those it marks. Each bone's posed sphere within
+ *  the margin (all bones side by side), then its grid
+ *  (pose__push_sphere_near, per brick). */
+size_t pose__push_near_bones(const pose__push *p, const float *cluster, const uint64_t *mask, uint32_t *near);
 /** The dynamic response's nodes (the state's tet mesh's soft nodes), with
  *  the state's allocator. */
 pose_status pose__push_build_nodes(pose__push *push, const struct pose_state *st);

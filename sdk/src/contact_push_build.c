@@ -563,7 +563,7 @@ pose_status pose__push_build(pose__push *p, const pose_state *st, float margin)
     p->frames = pose__alloc(&p->allocator, (nb + 1) * 12 * sizeof(float), POSE__ALIGN);
     p->bone_words = (nb + 63) / 64;
     p->bone_spheres = pose__alloc(&p->allocator, (4 * 64 * p->bone_words + 1) * sizeof(float), POSE__ALIGN);
-    p->near = pose__alloc(&p->allocator, (POSE__PUSH_ITEMS * p->bone_words + 1) * sizeof *p->near, POSE__ALIGN);
+    p->near = pose__alloc(&p->allocator, (POSE__PUSH_ITEMS * nb + 1) * sizeof *p->near, POSE__ALIGN);
     if (!p->bones || !p->frames || !p->bone_spheres || !p->near)
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu bones", nb);
     for (size_t j = 0; j < 4 * 64 * p->bone_words; j++) /* the padding never near (x infinite) */
