@@ -271,7 +271,7 @@ static void contact_item(void *ctx, size_t item)
             const pose__push_bone *b = &p->bones[j];
             const float *f = p->frames + 12 * j;
             for (size_t g = 0; g < groups; g++) {
-                if (!pose__push_sphere_near(b, f, group[g], 0))
+                if (!pose__push_spheres_near(p, j, group[g]) || !pose__push_sphere_near(b, f, group[g], 0))
                     continue;
                 const size_t gb = g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < count ? gb + POSE__PUSH_GROUP : count;
                 for (size_t i = gb; i < ge; i++) {

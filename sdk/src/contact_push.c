@@ -229,16 +229,6 @@ int pose__push_sphere_near(const pose__push_bone *b, const float *f, const float
     return !(gap > 1 && ((float)gap - 1.0f) * b->cell > reach);
 }
 
-/* Whether bone j's posed sphere comes within the margin of sphere c. */
-static inline int spheres_near(const pose__push *p, size_t j, const float *c)
-{
-    const size_t stride = 64 * p->bone_words;
-    const float *s = p->bone_spheres + j;
-    const float dx = c[0] - s[0], dy = c[1] - s[stride], dz = c[2] - s[2 * stride];
-    const float reach = c[3] + s[3 * stride] + p->margin;
-    return dx * dx + dy * dy + dz * dz <= reach * reach;
-}
-
 size_t pose__push_near_bones(const pose__push *p, const float *cluster, const uint64_t *mask, uint32_t *near)
 {
     size_t n = 0;
@@ -246,12 +236,12 @@ size_t pose__push_near_bones(const pose__push *p, const float *cluster, const ui
         uint64_t bits = 0;
         if (mask) { /* the few bones it marks */
             for (uint64_t m = mask[w]; m; m &= m - 1)
-                if (spheres_near(p, 64 * w + (size_t)__builtin_ctzll(m), cluster))
+                if (pose__push_spheres_near(p, 64 * w + (size_t)__builtin_ctzll(m), cluster))
                     bits |= m & -m;
         } else { /* all: 64 side by side (no branch), then their bits */
             uint8_t hit[64];
             for (size_t k = 0; k < 64; k++)
-                hit[k] = (uint8_t)spheres_near(p, 64 * w + k, cluster);
+                hit[k] = (uint8_t)pose__push_spheres_near(p, 64 * w + k, cluster);
             for (size_t k = 0; k < 64; k++)
                 bits |= (uint64_t)hit[k] << k;
         }
@@ -298,7 +288,7 @@ void pose__state_push_item(void *ctx, size_t item)
             const pose__push_bone *b = &p->bones[near[k]];
             const float *f = p->frames + 12 * (size_t)near[k];
             for (size_t g = 0; g < groups; g++) {
-                if (!pose__push_sphere_near(b, f, group[g], 0))
+                if (!pose__push_spheres_near(p, near[k], group[g]) || !pose__push_sphere_near(b, f, group[g], 0))
                     continue;
                 const size_t gb = vb + g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < ve ? gb + POSE__PUSH_GROUP : ve;
                 for (size_t i = gb; i < ge; i++) {

@@ -171,6 +171,16 @@ void pose__push_sphere(const float *pos, const uint32_t *idx, size_t begin, size
 /** Whether a posed sphere may hold a point bone b (frame f) needs tested
  *  (the grid's gap, per brick unless fine). */
 int pose__push_sphere_near(const pose__push_bone *b, const float *f, const float *sphere, int fine);
+/** Whether bone j's posed sphere comes within the margin of posed sphere
+ *  c: the first test of a cluster's or a group's sphere, before the grid's. */
+static inline int pose__push_spheres_near(const pose__push *p, size_t j, const float *c)
+{
+    const size_t stride = 64 * p->bone_words;
+    const float *s = p->bone_spheres + j;
+    const float dx = c[0] - s[0], dy = c[1] - s[stride], dz = c[2] - s[2 * stride];
+    const float reach = c[3] + s[3 * stride] + p->margin;
+    return dx * dx + dy * dy + dz * dz <= reach * reach;
+}
 /** The bones a cluster's posed bounding sphere may need tested against,
  *  in the rig's order, into near; their count. With mask (a bit per bone,
  *  bone_words words), only those it marks. Each bone's posed sphere within
