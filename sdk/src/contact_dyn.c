@@ -246,19 +246,14 @@ static void contact_item(void *ctx, size_t item)
     for (size_t c = cb; c < ce; c++) {
         const size_t vb = c * POSE__PUSH_CLUSTER,
                      ve = vb + POSE__PUSH_CLUSTER < p->node_count ? vb + POSE__PUSH_CLUSTER : p->node_count;
-        const size_t count = ve - vb, groups = (count + POSE__PUSH_GROUP - 1) / POSE__PUSH_GROUP;
+        const size_t count = ve - vb;
         float y[POSE__PUSH_CLUSTER][3], cluster[4], group[GROUPS][4];
         for (size_t i = 0; i < count; i++) {
             const size_t v = p->nodes[vb + i];
             for (int a = 0; a < 3; a++)
                 y[i][a] = d->x[3 * v + (size_t)a] + dt * d->v[3 * v + (size_t)a];
         }
-        pose__push_sphere(&y[0][0], NULL, 0, count, cluster);
-        for (size_t g = 0; g < groups; g++) {
-            const size_t gb = g * POSE__PUSH_GROUP;
-            pose__push_sphere(&y[0][0], NULL, gb, gb + POSE__PUSH_GROUP < count ? gb + POSE__PUSH_GROUP : count,
-                              group[g]);
-        }
+        const size_t groups = pose__push_spheres(&y[0][0], NULL, 0, count, cluster, group);
         node_contact nc[POSE__PUSH_CLUSTER];
         for (size_t i = 0; i < count; i++) {
             nc[i].count = 0;

@@ -189,19 +189,48 @@ static float push_vertex(const pose__push *p, const pose__push_bone *b, const fl
 
 /* Bounding sphere (the box's centre and half diagonal) of points
  * pos[3 idx[i]] (pos[3 i] when idx is NULL), i in [vb, ve). */
-void pose__push_sphere(const float *pos, const uint32_t *idx, size_t vb, size_t ve, float *sphere)
+/* Box lo, hi of those points, grown from what it holds. */
+static void grow_box(const float *pos, const uint32_t *idx, size_t vb, size_t ve, float *lo, float *hi)
 {
-    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t i = vb; i < ve; i++)
         for (int d = 0; d < 3; d++) {
             const float x = pos[3 * (size_t)(idx ? idx[i] : i) + (size_t)d];
             lo[d] = x < lo[d] ? x : lo[d];
             hi[d] = x > hi[d] ? x : hi[d];
         }
+}
+
+static void box_sphere(const float *lo, const float *hi, float *sphere)
+{
     for (int d = 0; d < 3; d++)
         sphere[d] = 0.5f * (lo[d] + hi[d]);
     sphere[3] = 0.5f * sqrtf((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                              (hi[2] - lo[2]) * (hi[2] - lo[2]));
+}
+
+void pose__push_sphere(const float *pos, const uint32_t *idx, size_t vb, size_t ve, float *sphere)
+{
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    grow_box(pos, idx, vb, ve, lo, hi);
+    box_sphere(lo, hi, sphere);
+}
+
+size_t pose__push_spheres(const float *pos, const uint32_t *idx, size_t vb, size_t ve, float *cluster,
+                          float (*group)[4])
+{
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    size_t g = 0;
+    for (size_t gb = vb; gb < ve; gb += POSE__PUSH_GROUP, g++) {
+        float glo[3] = {INFINITY, INFINITY, INFINITY}, ghi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        grow_box(pos, idx, gb, gb + POSE__PUSH_GROUP < ve ? gb + POSE__PUSH_GROUP : ve, glo, ghi);
+        box_sphere(glo, ghi, group[g]);
+        for (int d = 0; d < 3; d++) {
+            lo[d] = glo[d] < lo[d] ? glo[d] : lo[d];
+            hi[d] = ghi[d] > hi[d] ? ghi[d] : hi[d];
+        }
+    }
+    box_sphere(lo, hi, cluster);
+    return g;
 }
 
 /* A sphere (posed) can hold a point that bone b (frame f) needs tested: in
@@ -272,12 +301,7 @@ void pose__state_push_item(void *ctx, size_t item)
         const size_t vb = c * POSE__PUSH_CLUSTER,
                      ve = vb + POSE__PUSH_CLUSTER < p->vertex_count ? vb + POSE__PUSH_CLUSTER : p->vertex_count;
         float cluster[4], group[GROUPS][4];
-        pose__push_sphere(st->tissue_positions, p->order, vb, ve, cluster);
-        const size_t groups = (ve - vb + POSE__PUSH_GROUP - 1) / POSE__PUSH_GROUP;
-        for (size_t g = 0; g < groups; g++) {
-            const size_t gb = vb + g * POSE__PUSH_GROUP;
-            pose__push_sphere(st->tissue_positions, p->order, gb, gb + POSE__PUSH_GROUP < ve ? gb + POSE__PUSH_GROUP : ve, group[g]);
-        }
+        const size_t groups = pose__push_spheres(st->tissue_positions, p->order, vb, ve, cluster, group);
         /* One push per vertex per frame: a vertex pushed out of one bone into
          * another stays there rather than move by more than its depth. (A
          * vertex not yet pushed has not moved: the spheres hold it.) */

@@ -168,6 +168,11 @@ int pose__push_query(const pose__push *p, const pose__push_bone *b, const float 
 /** Bounding sphere (centre, radius) of the points pos[3 idx[i]] (pos[3 i]
  *  when idx is NULL), i in [begin, end). */
 void pose__push_sphere(const float *pos, const uint32_t *idx, size_t begin, size_t end, float *sphere);
+/** The same for each POSE__PUSH_GROUP of those points, in order, into
+ *  group, and all of them into cluster (its box from theirs: each point is
+ *  read once); the groups' count. */
+size_t pose__push_spheres(const float *pos, const uint32_t *idx, size_t begin, size_t end, float *cluster,
+                          float (*group)[4]);
 /** Whether a posed sphere may hold a point bone b (frame f) needs tested
  *  (the grid's gap, per brick unless fine). */
 int pose__push_sphere_near(const pose__push_bone *b, const float *f, const float *sphere, int fine);
