@@ -189,15 +189,21 @@ static float push_vertex(const pose__push *p, const pose__push_bone *b, const fl
 
 /* Bounding sphere (the box's centre and half diagonal) of points
  * pos[3 idx[i]] (pos[3 i] when idx is NULL), i in [vb, ve). */
-/* Box lo, hi of those points, grown from what it holds. */
+/* Box lo, hi of those points, grown from what it holds (the axes written
+ * out: the loop over them was not unrolled). */
 static void grow_box(const float *pos, const uint32_t *idx, size_t vb, size_t ve, float *lo, float *hi)
 {
-    for (size_t i = vb; i < ve; i++)
-        for (int d = 0; d < 3; d++) {
-            const float x = pos[3 * (size_t)(idx ? idx[i] : i) + (size_t)d];
-            lo[d] = x < lo[d] ? x : lo[d];
-            hi[d] = x > hi[d] ? x : hi[d];
-        }
+    float lx = lo[0], ly = lo[1], lz = lo[2], hx = hi[0], hy = hi[1], hz = hi[2];
+    for (size_t i = vb; i < ve; i++) {
+        const float *x = pos + 3 * (size_t)(idx ? idx[i] : i);
+        lx = x[0] < lx ? x[0] : lx;
+        ly = x[1] < ly ? x[1] : ly;
+        lz = x[2] < lz ? x[2] : lz;
+        hx = x[0] > hx ? x[0] : hx;
+        hy = x[1] > hy ? x[1] : hy;
+        hz = x[2] > hz ? x[2] : hz;
+    }
+    lo[0] = lx, lo[1] = ly, lo[2] = lz, hi[0] = hx, hi[1] = hy, hi[2] = hz;
 }
 
 static void box_sphere(const float *lo, const float *hi, float *sphere)
