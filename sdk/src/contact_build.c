@@ -78,7 +78,8 @@ void pose__bvh_release(pose__bvh *t, const pose_allocator *a)
 
 pose_status pose__bvh_index_corners(pose__bvh *t, const pose_allocator *a)
 {
-    uint32_t *begin = pose__alloc(a, ((size_t)t->leaf_count + 1) * sizeof *begin, POSE__ALIGN), triangles = 0;
+    uint32_t *begin = pose__alloc(a, ((size_t)t->leaf_count + 1) * sizeof *begin, POSE__ALIGN);
+    uint32_t triangles = 0;
     for (uint32_t k = 0; k < t->leaf_count; k++)
         triangles += t->nodes[t->leaves[k]].count;
     uint32_t *corners = pose__alloc(a, (3 * (size_t)triangles + 1) * sizeof *corners, POSE__ALIGN);

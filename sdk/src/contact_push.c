@@ -187,10 +187,9 @@ static float push_vertex(const pose__push *p, const pose__push_bone *b, const fl
     return sqrtf(moved);
 }
 
-/* Bounding sphere (the box's centre and half diagonal) of points
- * pos[3 idx[i]] (pos[3 i] when idx is NULL), i in [vb, ve). */
-/* Box lo, hi of those points, grown from what it holds (the axes written
- * out: the loop over them was not unrolled). */
+/* Box lo, hi grown to hold the points pos[3 idx[i]] (pos[3 i] when idx is
+ * NULL), i in [vb, ve) (the axes written out: the loop over them was not
+ * unrolled). */
 static void grow_box(const float *pos, const uint32_t *idx, size_t vb, size_t ve, float *lo, float *hi)
 {
     float lx = lo[0], ly = lo[1], lz = lo[2], hx = hi[0], hy = hi[1], hz = hi[2];
@@ -206,6 +205,7 @@ static void grow_box(const float *pos, const uint32_t *idx, size_t vb, size_t ve
     lo[0] = lx, lo[1] = ly, lo[2] = lz, hi[0] = hx, hi[1] = hy, hi[2] = hz;
 }
 
+/* A box's bounding sphere: its centre and half diagonal. */
 static void box_sphere(const float *lo, const float *hi, float *sphere)
 {
     for (int d = 0; d < 3; d++)
