@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* The baked body of tests/contact (tests/binding's coarse bake) and the
+/* The baked body of tests/contact (the tests' shared coarse bake) and the
  * issue's deep poses, shared by the contact tests and bench/contact. */
 #ifndef POSE_TEST_CONTACT_BODY_H
 #define POSE_TEST_CONTACT_BODY_H

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: Apache-2.0 */
 /* pose/contact.h detection on the body baked from data/anatomy (coarse,
- * tests/binding's bake) at issue 13's poses: the BVH counts of skin
+ * the tests' shared bake) at issue 13's poses: the BVH counts of skin
  * self-intersecting triangle pairs, skin vertices in bone and bone vertices
  * out of the skin equal brute-force counts with the same narrow phase
  * (runtime/rt_tri.h) and no hierarchy; 1 and 2 threads agree; invalid
