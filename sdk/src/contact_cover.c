@@ -497,9 +497,10 @@ void pose__cover_finish(pose__cover *l)
 static void refit_item(void *ctx, size_t item)
 {
     pose_state *st = ctx;
-    pose__bvh *t = &st->push->cover->skin;
-    pose__bvh_refit_leaves(t, st->tissue_positions, pose__part_begin(t->leaf_count, (unsigned)item, COVER_REFIT_ITEMS),
-                           pose__part_begin(t->leaf_count, (unsigned)item + 1, COVER_REFIT_ITEMS));
+    pose__cover *l = st->push->cover;
+    pose__bvh_refit_leaves(&l->skin, st->tissue_positions,
+                           pose__part_begin(l->skin.leaf_count, (unsigned)item, COVER_REFIT_ITEMS),
+                           pose__part_begin(l->skin.leaf_count, (unsigned)item + 1, COVER_REFIT_ITEMS));
 }
 
 void pose__state_cover(pose_state *st)
