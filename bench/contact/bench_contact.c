@@ -9,7 +9,9 @@
  * wall time waits for the cores), and the counts.
  * Then the response (pose_set_contact_response): pose_apply with it off
  * and on, per frame, on 1 and 2 threads: the difference is what the push
- * adds.
+ * adds, for a pose held (the frames after the first leave the clusters
+ * nothing moved near as they were: contact_quiet.h) and for a pose new at
+ * every frame (every cluster searched: what a moving body costs at most).
  * Usage: bench_contact RIG [--seconds S] [--response-only]
  *   (S per pose and thread count, default 1; --response-only skips the
  *   detection's timing)
@@ -20,8 +22,10 @@
 
 #include "bench_common.h"
 #include "contact_body.h"
+#include "contact_push.h"
 #include "pose/contact.h"
 #include "pose/pose.h"
+#include "state_internal.h"
 
 /* Wall and CPU seconds per pose_apply of `st`, repeated for `seconds`. */
 static void time_apply(pose_state *st, double seconds, double *wall, double *cpu)
@@ -63,26 +67,33 @@ static int bench_response(pose_rig *rig, double seconds)
         printf("response, DQS, %d thread%s (built in %.0f ms); CPU per thread per frame, min/median of %d "
                "interleaved blocks\n", threads, threads > 1 ? "s" : "", 1e3 * rs.build_seconds, BLOCKS);
         for (size_t p = 0; p < CONTACT_POSE_COUNT; p++) {
-            double w_off[BLOCKS], c_off[BLOCKS], w_on[BLOCKS], c_on[BLOCKS], add[BLOCKS];
+            double w_off[BLOCKS], c_off[BLOCKS], w_on[BLOCKS], c_on[BLOCKS], add[BLOCKS], add_new[BLOCKS], unused;
             contact_pose_set(rig, st, &contact_poses[p]);
             for (int b = 0; b < BLOCKS; b++) {
+                double c_new;
                 pose_set_contact_response(st, &off);
                 time_apply(st, seconds / BLOCKS, &w_off[b], &c_off[b]);
                 pose_set_contact_response(st, &on);
                 time_apply(st, seconds / BLOCKS, &w_on[b], &c_on[b]);
+                st->push->quiet_off = 1;
+                time_apply(st, seconds / BLOCKS, &unused, &c_new);
+                st->push->quiet_off = 0;
                 add[b] = c_on[b] - c_off[b];
+                add_new[b] = c_new - c_off[b];
             }
             pose_get_contact_response_stats(st, &rs);
             qsort(c_off, BLOCKS, sizeof(double), cmp_double);
             qsort(c_on, BLOCKS, sizeof(double), cmp_double);
             qsort(add, BLOCKS, sizeof(double), cmp_double);
+            qsort(add_new, BLOCKS, sizeof(double), cmp_double);
             qsort(w_off, BLOCKS, sizeof(double), cmp_double);
             qsort(w_on, BLOCKS, sizeof(double), cmp_double);
             const double k = 1e3 / threads;
-            printf("  %-18s: pose_apply off %5.2f/%5.2f, on %5.2f/%5.2f ms; added %5.2f/%5.2f ms (wall median "
-                   "%.2f -> %.2f); %zu skin vertices pushed\n", contact_poses[p].label, k * c_off[0],
-                   k * c_off[BLOCKS / 2], k * c_on[0], k * c_on[BLOCKS / 2], k * (c_on[0] - c_off[0]),
-                   k * add[BLOCKS / 2], 1e3 * w_off[BLOCKS / 2], 1e3 * w_on[BLOCKS / 2], rs.pushed);
+            printf("  %-18s: pose_apply off %5.2f/%5.2f, on %5.2f/%5.2f ms; added %5.2f/%5.2f ms held, "
+                   "%5.2f ms median a new pose every frame (wall median %.2f -> %.2f held); %zu skin vertices "
+                   "pushed\n", contact_poses[p].label, k * c_off[0], k * c_off[BLOCKS / 2], k * c_on[0],
+                   k * c_on[BLOCKS / 2], k * (c_on[0] - c_off[0]), k * add[BLOCKS / 2], k * add_new[BLOCKS / 2],
+                   1e3 * w_off[BLOCKS / 2], 1e3 * w_on[BLOCKS / 2], rs.pushed);
         }
         pose_state_free(st);
     }

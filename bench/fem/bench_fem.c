@@ -35,6 +35,7 @@
 #include <string.h>
 
 #include "bench_common.h"
+#include "contact_push.h"
 #include "fem_volume.h"
 #include "pose/contact.h"
 #include "pose/pose.h"
@@ -103,7 +104,7 @@ static int bench_dynamics(const pose_rig *rig, int threads, int steps, int conta
         return -1;
     }
     pose_dynamics_stats ds = {.size = sizeof ds}, sum = {0};
-    double wall = 0.0, cpu = 0.0, peak = 0.0, skin_push = 0.0;
+    double wall = 0.0, cpu = 0.0, peak = 0.0, skin_push = 0.0, quiet_nodes = 0.0, quiet_skin = 0.0;
     int cg_max = 0;
     for (int s = 1; s <= steps; s++) {
         const double t = s * dt, u = fmod(fmin(t, swing) * rate, 180.0);
@@ -123,8 +124,12 @@ static int bench_dynamics(const pose_rig *rig, int threads, int steps, int conta
         sum.seconds_transfer += ds.seconds_transfer;
         sum.seconds_contact += ds.seconds_contact;
         pose_contact_response_stats cs = {.size = sizeof cs};
-        if (contact && pose_get_contact_response_stats(st, &cs) == POSE_OK)
+        if (contact && pose_get_contact_response_stats(st, &cs) == POSE_OK) {
             skin_push += cs.seconds;
+            const pose__push *p = st->push; /* clusters the passes left as they were (contact_quiet.h) */
+            quiet_nodes += (double)pose__quiet_held(&p->node_quiet) / (double)p->node_clusters;
+            quiet_skin += (double)pose__quiet_held(&p->skin_quiet) / (double)p->cluster_count;
+        }
         sum.contacts += ds.contacts;
         sum.cg_iterations += ds.cg_iterations;
         cg_max = ds.cg_iterations > cg_max ? ds.cg_iterations : cg_max;
@@ -151,9 +156,10 @@ static int bench_dynamics(const pose_rig *rig, int threads, int steps, int conta
            sum.seconds_transfer * ms);
     if (contact)
         printf("  contact: %.2f ms/step (timers): nodes' constraints %.2f, the skin's push %.2f; %.1f "
-               "constraints per step; %.1f %% of the rest of the step's timers\n",
+               "constraints per step; clusters left quiet %.1f %% of the nodes', %.1f %% of the skin's; %.1f %% "
+               "of the rest of the step's timers\n",
                sum.seconds_contact * ms, (sum.seconds_contact - skin_push) * ms, skin_push * ms,
-               (double)sum.contacts / steps,
+               (double)sum.contacts / steps, 100.0 * quiet_nodes / steps, 100.0 * quiet_skin / steps,
                100.0 * sum.seconds_contact /
                    (sum.seconds_skin + sum.seconds_assembly + sum.seconds_cg + sum.seconds_transfer));
     if (ms_step)

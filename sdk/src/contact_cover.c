@@ -470,7 +470,7 @@ float pose__cover_bound(const pose__push *p, const pose__push_bone *b, const flo
         x0[d] = before[d] - a[3] * a[d];
         total[d] = x[d] - x0[d];
     }
-    if (pose__push_query(p, b, f, x0, NULL, &sd, c, out)) {
+    if (pose__push_query(p, b, f, x0, NULL, &sd, c, out, NULL)) {
         float q[3], z[3];
         for (int d = 0; d < 3; d++)
             q[d] = c[d] + p->margin * out[d];

@@ -243,6 +243,7 @@ static void contact_item(void *ctx, size_t item)
     float impulse = 0.0f, moved = 0.0f, excess = 0.0f;
     const size_t cb = pose__part_begin(p->node_clusters, (unsigned)item, POSE__PUSH_ITEMS),
                  ce = pose__part_begin(p->node_clusters, (unsigned)item + 1, POSE__PUSH_ITEMS);
+    float *bound = p->bound + item * p->joint_count;
     for (size_t c = cb; c < ce; c++) {
         const size_t vb = c * POSE__PUSH_CLUSTER,
                      ve = vb + POSE__PUSH_CLUSTER < p->node_count ? vb + POSE__PUSH_CLUSTER : p->node_count;
@@ -253,26 +254,37 @@ static void contact_item(void *ctx, size_t item)
             for (int a = 0; a < 3; a++)
                 y[i][a] = d->x[3 * v + (size_t)a] + dt * d->v[3 * v + (size_t)a];
         }
-        const size_t groups = pose__push_spheres(&y[0][0], NULL, 0, count, cluster, group);
         node_contact nc[POSE__PUSH_CLUSTER];
         for (size_t i = 0; i < count; i++) {
             nc[i].count = 0;
             nc[i].depth = 0.0f;
         }
-        uint32_t *near = p->near + item * p->bone_count;
-        const size_t near_count = pose__push_near_bones(p, cluster, NULL, near);
+        /* a quiet cluster (contact_quiet.h) has no constraint: its nodes'
+         * resting contacts are updated as the full pass would */
+        const int quiet =
+            !p->quiet_off && pose__quiet_holds(&p->node_quiet, p->joint_motion, p->margin, c, &y[0][0], NULL, count);
+        if (!quiet) {
+            pose__quiet_begin(&p->node_quiet, c, &y[0][0], NULL, count);
+            for (size_t k = 0; k < p->joint_count; k++)
+                bound[k] = INFINITY;
+        }
+        const size_t groups = quiet ? 0 : pose__push_spheres(&y[0][0], NULL, 0, count, cluster, group);
+        const uint32_t *near = p->near + item * p->bone_count;
+        const size_t near_count = quiet ? 0 : pose__push_near_bones(p, item, cluster, NULL, bound);
         for (size_t kb = 0; kb < near_count; kb++) {
             const size_t j = near[kb];
             const pose__push_bone *b = &p->bones[j];
             const float *f = p->frames + 12 * j;
             for (size_t g = 0; g < groups; g++) {
-                if (!pose__push_spheres_near(p, j, group[g]) || !pose__push_sphere_near(b, f, group[g], 0))
+                if (!pose__push_group_near(p, j, group[g], bound))
                     continue;
                 const size_t gb = g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < count ? gb + POSE__PUSH_GROUP : count;
                 for (size_t i = gb; i < ge; i++) {
-                    float sd, q[3], out[3];
-                    if (nc[i].count == MAX_CONSTRAINTS ||
-                        !pose__push_query(p, b, f, y[i], &p->node_cache[vb + i], &sd, q, out))
+                    float sd, q[3], out[3], clear = 0.0f;
+                    const int hit = nc[i].count < MAX_CONSTRAINTS &&
+                                    pose__push_query(p, b, f, y[i], &p->node_cache[vb + i], &sd, q, out, &clear);
+                    pose__quiet_bound(bound, b->joint, clear);
+                    if (!hit)
                         continue;
                     const float plane = p->node_bone[vb + i] == j ? p->node_gap[vb + i] : p->margin;
                     /* a resting contact holds the node at its plane: the
@@ -294,6 +306,8 @@ static void contact_item(void *ctx, size_t item)
                 }
             }
         }
+        if (!quiet)
+            pose__quiet_end(&p->node_quiet, p->joint_motion, c, bound);
         for (size_t i = 0; i < count; i++) {
             const size_t v = p->nodes[vb + i];
             const float *b = pre + 6 * v, s = (b[0] + b[3] + b[5]) * (1.0f / 3.0f);

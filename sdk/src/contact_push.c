@@ -16,21 +16,49 @@
  * (rig units; metres for pose-bake's rigs). */
 #define DEFAULT_MARGIN 0.0005f
 
+/* The bones' frames for the pose, and each joint's running move
+ * (contact_quiet.h): the farthest any point of its bones' rest spheres
+ * went from the last frames to these, |R' - R| r + the centre's move
+ * (|R' - R| by its Frobenius norm, which bounds the spectral one; with
+ * room for rounding wherever a frame changed). */
 void pose__state_push_frames(pose_state *st)
 {
     pose__push *p = st->push;
     const size_t stride = 64 * p->bone_words;
+    float *step = p->bound; /* the items' scratch: no item runs now */
+    for (size_t k = 0; k < p->joint_count; k++)
+        step[k] = 0.0f;
     for (size_t j = 0; j < p->bone_count; j++) {
         const pose__push_bone *b = &p->bones[j];
         const pose__xform *m = &st->skin[b->joint];
-        float *f = p->frames + 12 * j;
+        float *f = p->frames + 12 * j, was[12], rot = 0.0f, moved = 0.0f;
+        memcpy(was, f, sizeof was);
         pose__quat_to_matrix(m->q, f);
         memcpy(f + 9, m->t, 3 * sizeof(float));
-        for (int r = 0; r < 3; r++)
-            p->bone_spheres[(size_t)r * stride + j] =
-                f[3 * r] * b->center[0] + f[3 * r + 1] * b->center[1] + f[3 * r + 2] * b->center[2] + f[9 + r];
+        for (int k = 0; k < 9; k++)
+            rot += (f[k] - was[k]) * (f[k] - was[k]);
+        for (int r = 0; r < 3; r++) {
+            float *c = p->bone_spheres + (size_t)r * stride + j;
+            const float now = f[3 * r] * b->center[0] + f[3 * r + 1] * b->center[1] + f[3 * r + 2] * b->center[2] + f[9 + r];
+            moved += (now - *c) * (now - *c);
+            *c = now;
+        }
         p->bone_spheres[3 * stride + j] = b->radius;
+        if (rot > 0.0f || moved > 0.0f) {
+            const float move = (sqrtf(rot) + 1e-6f) * b->radius + sqrtf(moved) + 1e-6f;
+            step[b->joint] = move > step[b->joint] ? move : step[b->joint];
+        }
     }
+    for (size_t k = 0; k < p->joint_count; k++) {
+        if (p->joint_start[k + 1] == p->joint_start[k])
+            continue;
+        const float *f = p->frames + 12 * (size_t)p->joint_bones[p->joint_start[k]], *c = p->joint_spheres + 8 * k;
+        for (int r = 0; r < 3; r++)
+            p->joint_spheres[8 * k + 4 + (size_t)r] = f[3 * r] * c[0] + f[3 * r + 1] * c[1] + f[3 * r + 2] * c[2] + f[9 + r];
+        if (p->frames_set)
+            p->joint_motion[k] += step[k];
+    }
+    p->frames_set = 1;
 }
 
 /* x (posed) into the bone's rest frame: R^T (x - t). */
@@ -84,10 +112,14 @@ static void remember(pose__push_cache *cache, const float *q, float d, uint32_t 
 }
 
 int pose__push_query(const pose__push *p, const pose__push_bone *b, const float *f, const float *x,
-                     pose__push_cache *cache, float *signed_distance, float *closest, float *outward)
+                     pose__push_cache *cache, float *signed_distance, float *closest, float *outward,
+                     float *bound)
 {
-    float q[3];
+    float q[3], unknown;
     to_rest(f, x, q);
+    if (!bound)
+        bound = &unknown;
+    *bound = 0.0f;
     const uint32_t j = (uint32_t)(b - p->bones);
     for (int k = 0; cache && k < 2; k++)
         if (cache->slot[k].bone == j) {
@@ -97,18 +129,23 @@ int pose__push_query(const pose__push *p, const pose__push_bone *b, const float 
              * crosses no surface) */
             const float dx = q[0] - cache->slot[k].q[0], dy = q[1] - cache->slot[k].q[1],
                         dz = q[2] - cache->slot[k].q[2], room = cache->slot[k].d - p->margin;
-            if (dx * dx + dy * dy + dz * dz < room * room)
+            const float d2 = dx * dx + dy * dy + dz * dz;
+            if (d2 < room * room) {
+                if (bound != &unknown)
+                    *bound = cache->slot[k].d - sqrtf(d2);
                 return 0;
+            }
         }
     if (!in_box(b, q, 0.0f)) {
-        if (cache) { /* outside the box, which is the bone's grown by a cell and the margin */
+        if (cache || bound != &unknown) { /* outside the box, which is the bone's grown by a cell and the margin */
             float e2 = 0.0f;
             for (int d = 0; d < 3; d++) {
                 const float e = q[d] < b->lo[d] ? b->lo[d] - q[d] : q[d] > b->hi[d] ? q[d] - b->hi[d] : 0.0f;
                 e2 += e * e;
             }
-            const float d = sqrtf(e2) + b->cell + p->margin;
-            remember(cache, q, d, j);
+            *bound = sqrtf(e2) + b->cell + p->margin;
+            if (cache)
+                remember(cache, q, *bound, j);
         }
         return 0;
     }
@@ -116,8 +153,9 @@ int pose__push_query(const pose__push *p, const pose__push_bone *b, const float 
     if (code >= POSE__CELL_OUT) {
         /* every cell that is not OUT lies (gap - 1) cells or more away,
          * and the surface and its margin are in those */
+        *bound = (float)(code - POSE__CELL_OUT) * b->cell + p->margin;
         if (cache && code > POSE__CELL_OUT)
-            remember(cache, q, (float)(code - POSE__CELL_OUT) * b->cell + p->margin, j);
+            remember(cache, q, *bound, j);
         return 0;
     }
     /* A point of a NEAR_OUT cell is outside: only a triangle within the
@@ -137,19 +175,24 @@ int pose__push_query(const pose__push *p, const pose__push_bone *b, const float 
                                                                          : near,
                                    c, out);
     if (code == POSE__CELL_NEAR_OUT && !(fabsf(sd) < p->margin)) { /* nothing within the margin */
+        *bound = !cache ? p->margin : isinf(sd) ? near : fabsf(sd);
         if (cache)
-            remember(cache, q, isinf(sd) ? near : fabsf(sd), j);
+            remember(cache, q, *bound, j);
         return 0;
     }
     if (isinf(sd)) {
         if (pose__bvh_winding_along(&b->tree, b->rest, q, f) <= 0) {
-            if (cache && code != POSE__CELL_IN)
-                remember(cache, q, near, j);
+            if (code != POSE__CELL_IN) {
+                *bound = near;
+                if (cache)
+                    remember(cache, q, near, j);
+            }
             return 0;
         }
         sd = pose__push_distance(b, q, INFINITY, c, out);
     }
     if (!(sd < p->margin)) {
+        *bound = sd;
         if (cache)
             remember(cache, q, sd, j);
         return 0;
@@ -169,12 +212,13 @@ int pose__push_query(const pose__push *p, const pose__push_bone *b, const float 
 }
 
 /* Push x (posed) out of bone b (frame f) to the margin; the move's length,
- * or 0 when x is farther than the margin outside. */
+ * or 0 when x is farther than the margin outside (what the query proved
+ * of its distance into *bound). */
 static float push_vertex(const pose__push *p, const pose__push_bone *b, const float *f, float *x,
-                         pose__push_cache *cache)
+                         pose__push_cache *cache, float *bound)
 {
     float sd, c[3], out[3];
-    if (!pose__push_query(p, b, f, x, cache, &sd, c, out))
+    if (!pose__push_query(p, b, f, x, cache, &sd, c, out, bound))
         return 0.0f;
     float q[3], y[3], moved = 0.0f;
     for (int k = 0; k < 3; k++)
@@ -239,61 +283,101 @@ size_t pose__push_spheres(const float *pos, const uint32_t *idx, size_t vb, size
     return g;
 }
 
-/* A sphere (posed) can hold a point that bone b (frame f) needs tested: in
- * the grid's box, and not all in OUT cells (its centre's cell more than
- * radius + a cell from any non-OUT one: the gap, or its brick's least,
- * which reads a smaller map, when not `fine`). */
-int pose__push_sphere_near(const pose__push_bone *b, const float *f, const float *sphere, int fine)
+int pose__push_sphere_far(const pose__push *p, size_t j, const float *sphere, float *bound)
 {
+    const pose__push_bone *b = &p->bones[j];
     float q[3];
-    to_rest(f, sphere, q);
-    if (!in_box(b, q, sphere[3]))
-        return 0;
+    to_rest(p->frames + 12 * j, sphere, q);
+    if (!in_box(b, q, sphere[3])) { /* the box is the bone's grown by a cell and the margin */
+        if (bound) {
+            float e2 = 0.0f;
+            for (int d = 0; d < 3; d++) {
+                const float e = q[d] < b->lo[d] ? b->lo[d] - q[d] : q[d] > b->hi[d] ? q[d] - b->hi[d] : 0.0f;
+                e2 += e * e;
+            }
+            pose__quiet_bound_root(bound, b->joint, e2, sphere[3] - b->cell - p->margin);
+        }
+        return 1;
+    }
     int i[3];
     const size_t brick = brick_of(b, q, i);
-    /* the brick's least gap first (a small map, mostly in cache): a cell's
-     * gap is at least its brick's, so what the brick rejects the cell does */
+    /* the brick's least gap (a small map, mostly in cache): a cell's gap
+     * is at least its brick's; its non-OUT cells hold the surface and its
+     * margin */
     const float reach = sphere[3] * 1.001f + 1e-6f;
     const int least = b->brick_gap[brick];
-    if (least > 1 && ((float)least - 1.0f) * b->cell > reach)
-        return 0;
-    if (!fine)
+    if (least > 1 && ((float)least - 1.0f) * b->cell > reach) {
+        pose__quiet_bound(bound, b->joint, ((float)least - 1.0f) * b->cell - sphere[3] + p->margin);
         return 1;
-    const uint8_t code = b->grid[64 * brick + (size_t)((i[2] & 3) << 4 | (i[1] & 3) << 2 | (i[0] & 3))];
-    const int gap = code >= POSE__CELL_OUT ? code - (POSE__CELL_OUT - 1) : 0;
-    return !(gap > 1 && ((float)gap - 1.0f) * b->cell > reach);
+    }
+    return 0;
 }
 
-size_t pose__push_near_bones(const pose__push *p, const float *cluster, const uint64_t *mask, uint32_t *near)
+/* How far a joint's sphere may lie from a cluster's for its gap to stand
+ * for its bones' in the cluster's quiet bound (rig units: 30 mm), instead
+ * of each bone's own: a cluster stays quiet that long either way. */
+#define QUIET_FAR 0.03f
+
+/* What the sphere tests proved of the bones not hit (hit: a byte per
+ * bone), into bound: per joint, its sphere's gap when far, else its
+ * bones' own. */
+static void bound_spheres(const pose__push *p, const float *cluster, const uint8_t *hit, float *bound)
 {
+    for (size_t k = 0; k < p->joint_count; k++) {
+        const float *js = p->joint_spheres + 8 * k + 4;
+        const float dx = cluster[0] - js[0], dy = cluster[1] - js[1], dz = cluster[2] - js[2];
+        const float gap = sqrtf(dx * dx + dy * dy + dz * dz) - cluster[3] - js[3];
+        if (gap > QUIET_FAR) {
+            pose__quiet_bound(bound, (int)k, gap);
+            continue;
+        }
+        for (uint32_t e = p->joint_start[k]; e < p->joint_start[k + 1]; e++)
+            if (!hit[p->joint_bones[e]])
+                pose__push_spheres_bound(p, p->joint_bones[e], cluster, bound);
+    }
+}
+
+size_t pose__push_near_bones(const pose__push *p, size_t item, const float *cluster, const uint64_t *mask,
+                             float *bound)
+{
+    uint32_t *near = p->near + item * p->bone_count;
+    uint8_t *hit = p->hit + item * p->bone_count;
     size_t n = 0;
     for (size_t w = 0; w < p->bone_words; w++) {
         uint64_t bits = 0;
         if (mask) { /* the few bones it marks */
-            for (uint64_t m = mask[w]; m; m &= m - 1)
-                if (pose__push_spheres_near(p, 64 * w + (size_t)__builtin_ctzll(m), cluster))
+            for (uint64_t m = mask[w]; m; m &= m - 1) {
+                const size_t j = 64 * w + (size_t)__builtin_ctzll(m);
+                if (pose__push_spheres_near(p, j, cluster))
                     bits |= m & -m;
+                else
+                    pose__push_spheres_bound(p, j, cluster, bound);
+            }
         } else { /* all: 64 side by side (no branch), then their bits */
-            uint8_t hit[64];
-            for (size_t k = 0; k < 64; k++)
-                hit[k] = (uint8_t)pose__push_spheres_near(p, 64 * w + k, cluster);
-            for (size_t k = 0; k < 64; k++)
-                bits |= (uint64_t)hit[k] << k;
+            uint8_t *h = hit + 64 * w;
+            const size_t count = p->bone_count - 64 * w < 64 ? p->bone_count - 64 * w : 64;
+            for (size_t k = 0; k < count; k++)
+                h[k] = (uint8_t)pose__push_spheres_near(p, 64 * w + k, cluster);
+            for (size_t k = 0; k < count; k++)
+                bits |= (uint64_t)h[k] << k;
         }
         for (; bits; bits &= bits - 1) {
             const size_t j = 64 * w + (size_t)__builtin_ctzll(bits);
-            if (pose__push_sphere_near(&p->bones[j], p->frames + 12 * j, cluster, 0))
+            if (!pose__push_sphere_far(p, j, cluster, bound))
                 near[n++] = (uint32_t)j;
         }
     }
+    if (bound && !mask)
+        bound_spheres(p, cluster, hit, bound);
     return n;
 }
 
 /* Clusters split into items: each vertex is moved by one item, bone after
  * bone in the rig's order, and each item writes its own counts, so any
  * thread count and any assignment of items give the same bits. A cluster
- * is tested against a bone's sphere, box and grid, then its groups of
- * POSE__PUSH_GROUP against box and grid, then their vertices. */
+ * still quiet (contact_quiet.h) is left as it is; the others are tested
+ * against a bone's sphere, box and grid, then their groups of
+ * POSE__PUSH_GROUP against sphere and grid, then their vertices. */
 void pose__state_push_item(void *ctx, size_t item)
 {
     pose_state *st = ctx;
@@ -303,30 +387,38 @@ void pose__state_push_item(void *ctx, size_t item)
     enum { GROUPS = POSE__PUSH_CLUSTER / POSE__PUSH_GROUP };
     const size_t cb = pose__part_begin(p->cluster_count, (unsigned)item, POSE__PUSH_ITEMS),
                  ce = pose__part_begin(p->cluster_count, (unsigned)item + 1, POSE__PUSH_ITEMS);
+    float *bound = p->bound + item * p->joint_count;
     for (size_t c = cb; c < ce; c++) {
         const size_t vb = c * POSE__PUSH_CLUSTER,
                      ve = vb + POSE__PUSH_CLUSTER < p->vertex_count ? vb + POSE__PUSH_CLUSTER : p->vertex_count;
+        if (!p->quiet_off && pose__quiet_holds(&p->skin_quiet, p->joint_motion, p->margin, c,
+                                               st->tissue_positions, p->order + vb, ve - vb))
+            continue;
+        pose__quiet_begin(&p->skin_quiet, c, st->tissue_positions, p->order + vb, ve - vb);
+        for (size_t k = 0; k < p->joint_count; k++)
+            bound[k] = INFINITY;
         float cluster[4], group[GROUPS][4];
         const size_t groups = pose__push_spheres(st->tissue_positions, p->order, vb, ve, cluster, group);
         /* One push per vertex per frame: a vertex pushed out of one bone into
          * another stays there rather than move by more than its depth. (A
          * vertex not yet pushed has not moved: the spheres hold it.) */
         uint8_t done[POSE__PUSH_CLUSTER] = {0};
-        uint32_t *near = p->near + item * p->bone_count;
-        const size_t near_count = pose__push_near_bones(p, cluster, p->reach + c * p->bone_words, near);
+        const uint32_t *near = p->near + item * p->bone_count;
+        const size_t near_count = pose__push_near_bones(p, item, cluster, p->reach + c * p->bone_words, bound);
         for (size_t k = 0; k < near_count; k++) {
             const pose__push_bone *b = &p->bones[near[k]];
             const float *f = p->frames + 12 * (size_t)near[k];
             for (size_t g = 0; g < groups; g++) {
-                if (!pose__push_spheres_near(p, near[k], group[g]) || !pose__push_sphere_near(b, f, group[g], 0))
+                if (!pose__push_group_near(p, near[k], group[g], bound))
                     continue;
                 const size_t gb = vb + g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < ve ? gb + POSE__PUSH_GROUP : ve;
                 for (size_t i = gb; i < ge; i++) {
                     if (p->skip[i] || done[i - vb] || p->own_joint[i] == b->joint)
                         continue;
-                    float *x = st->tissue_positions + 3 * (size_t)p->order[i], before[3];
+                    float *x = st->tissue_positions + 3 * (size_t)p->order[i], before[3], clear;
                     memcpy(before, x, sizeof before);
-                    float m = push_vertex(p, b, f, x, &p->cache[i]);
+                    float m = push_vertex(p, b, f, x, &p->cache[i], &clear);
+                    pose__quiet_bound(bound, b->joint, clear);
                     done[i - vb] = m > 0.0f;
                     if (m > 0.0f) {
                         /* lifted first: counted by the cover, its whole move here */
@@ -338,6 +430,7 @@ void pose__state_push_item(void *ctx, size_t item)
                 }
             }
         }
+        pose__quiet_end(&p->skin_quiet, p->joint_motion, c, bound);
     }
     p->pushed[item] = pushed;
     p->max_push[item] = most;

@@ -14,9 +14,11 @@
 #ifndef POSE_CONTACT_PUSH_H
 #define POSE_CONTACT_PUSH_H
 
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 
+#include "contact_quiet.h"
 #include "pose/contact.h"
 #include "rt_bvh.h"
 
@@ -112,6 +114,17 @@ typedef struct pose__push {
     float *bone_spheres;    /**< per frame, posed: the bones' centres' x, then y, z and radii,
                                  64 bone_words each (padding: x infinite, never near) */
     uint32_t *near;         /**< per item: scratch for pose__push_near_bones, bone_count entries */
+    uint8_t *hit;           /**< per item: its scratch too, bone_count bytes */
+    size_t joint_count;     /**< the rig's joints */
+    double *joint_motion;   /**< per joint: how far its bones have moved, summed over the
+                                 frames (pose__state_push_frames; contact_quiet.h) */
+    int frames_set;         /**< frames holds a pose (the next one's move is measured from it) */
+    float *bound;           /**< per item: scratch, a bound per joint (contact_quiet.h) */
+    uint32_t *joint_start;  /**< per joint + 1: where its bones start in joint_bones */
+    uint32_t *joint_bones;  /**< bones (indices in bones) joint by joint */
+    float *joint_spheres;   /**< per joint: a sphere holding its bones' at rest (4), then posed (4) */
+    pose__quiet skin_quiet; /**< the skin's clusters' last full passes */
+    int quiet_off;          /**< tests: every cluster's pass in full */
     size_t pushed[POSE__PUSH_ITEMS]; /**< per item of the last pass */
     float max_push[POSE__PUSH_ITEMS];
     struct pose__cover *cover; /**< skin lifted over bone before the push (contact_cover.h) */
@@ -123,6 +136,7 @@ typedef struct pose__push {
                                  put it (0: pushed out of bone as pose_apply does) */
     uint32_t *nodes;        /**< soft nodes (tet vertices), cluster by cluster (Morton order at rest) */
     pose__push_cache *node_cache; /**< per node */
+    pose__quiet node_quiet; /**< the nodes' clusters' last full passes */
     uint16_t *node_bone;    /**< per entry: the bone (index in bones) it lies within the margin
                                  of at rest, or UINT16_MAX */
     float *node_gap;        /**< per entry: its distance to that bone at rest: the constraint's
@@ -162,9 +176,12 @@ float pose__push_distance(const pose__push_bone *b, const float *q, float max_di
  *  direction, both in the bone's rest frame; else 0. The one query of the
  *  kinematic and the dynamic response. cache (the point's own, or NULL)
  *  skips the search where the last one proves the point outside, and is
- *  updated where this one does: the same answers, fewer searches. */
+ *  updated where this one does: the same answers, fewer searches. With
+ *  bound (or NULL), a lower bound on the point's distance to the bone
+ *  where it returns 0 and knows one (0 where not, and where it returns 1). */
 int pose__push_query(const pose__push *p, const pose__push_bone *b, const float *f, const float *x,
-                     pose__push_cache *cache, float *signed_distance, float *closest, float *outward);
+                     pose__push_cache *cache, float *signed_distance, float *closest, float *outward,
+                     float *bound);
 /** Bounding sphere (centre, radius) of the points pos[3 idx[i]] (pos[3 i]
  *  when idx is NULL), i in [begin, end). */
 void pose__push_sphere(const float *pos, const uint32_t *idx, size_t begin, size_t end, float *sphere);
@@ -173,9 +190,12 @@ void pose__push_sphere(const float *pos, const uint32_t *idx, size_t begin, size
  *  read once); the groups' count. */
 size_t pose__push_spheres(const float *pos, const uint32_t *idx, size_t begin, size_t end, float *cluster,
                           float (*group)[4]);
-/** Whether a posed sphere may hold a point bone b (frame f) needs tested
- *  (the grid's gap, per brick unless fine). */
-int pose__push_sphere_near(const pose__push_bone *b, const float *f, const float *sphere, int fine);
+/** 1 when no point of a posed sphere needs testing against bone j (posed
+ *  by its frame): the sphere is outside the grid's box, or its centre's
+ *  brick's least gap proves all of it farther than the margin; then what
+ *  that proves of its points' distance to the bone, into bound (per joint,
+ *  or NULL). Else 0. */
+int pose__push_sphere_far(const pose__push *p, size_t j, const float *sphere, float *bound);
 /** Whether bone j's posed sphere comes within the margin of posed sphere
  *  c: the first test of a cluster's or a group's sphere, before the grid's. */
 static inline int pose__push_spheres_near(const pose__push *p, size_t j, const float *c)
@@ -186,12 +206,34 @@ static inline int pose__push_spheres_near(const pose__push *p, size_t j, const f
     const float reach = c[3] + s[3 * stride] + p->margin;
     return dx * dx + dy * dy + dz * dz <= reach * reach;
 }
+/** What posed sphere c apart from bone j's proves of its points' distance
+ *  to the bone (which lies in its sphere), into bound (per joint). */
+static inline void pose__push_spheres_bound(const pose__push *p, size_t j, const float *c, float *bound)
+{
+    const size_t stride = 64 * p->bone_words;
+    const float *s = p->bone_spheres + j;
+    const float dx = c[0] - s[0], dy = c[1] - s[stride], dz = c[2] - s[2 * stride];
+    pose__quiet_bound_root(bound, p->bones[j].joint, dx * dx + dy * dy + dz * dz, c[3] + s[3 * stride]);
+}
+/** Whether a group's posed sphere may hold a point bone j needs tested
+ *  (bones' spheres, then the grid's); if not, what the test proved, into
+ *  bound (per joint, or NULL). */
+static inline int pose__push_group_near(const pose__push *p, size_t j, const float *group, float *bound)
+{
+    if (!pose__push_spheres_near(p, j, group)) {
+        pose__push_spheres_bound(p, j, group, bound);
+        return 0;
+    }
+    return !pose__push_sphere_far(p, j, group, bound);
+}
 /** The bones a cluster's posed bounding sphere may need tested against,
- *  in the rig's order, into near; their count. With mask (a bit per bone,
- *  bone_words words), only those it marks. Each bone's posed sphere within
- *  the margin (all bones side by side), then its grid
- *  (pose__push_sphere_near, per brick). */
-size_t pose__push_near_bones(const pose__push *p, const float *cluster, const uint64_t *mask, uint32_t *near);
+ *  in the rig's order, into item's near; their count. With mask (a bit per
+ *  bone, bone_words words), only those it marks. Each bone's posed sphere
+ *  within the margin (all bones side by side), then its grid
+ *  (pose__push_sphere_far, per brick). With bound (per joint, or NULL),
+ *  what the tests proved of the bones left out (contact_quiet.h). */
+size_t pose__push_near_bones(const pose__push *p, size_t item, const float *cluster, const uint64_t *mask,
+                             float *bound);
 /** The dynamic response's nodes (the state's tet mesh's soft nodes), with
  *  the state's allocator. */
 pose_status pose__push_build_nodes(pose__push *push, const struct pose_state *st);

@@ -512,6 +512,48 @@ static pose_status mark_rigid(pose__push *p, const pose_state *st)
     return POSE_OK;
 }
 
+/* Each joint's bones, and a sphere holding their rest spheres (the
+ * clusters' quiet bounds: contact_quiet.h). */
+static pose_status joint_spheres(pose__push *p)
+{
+    const size_t nj = p->joint_count;
+    p->joint_start = pose__calloc(&p->allocator, (nj + 2) * sizeof *p->joint_start, POSE__ALIGN);
+    p->joint_bones = pose__alloc(&p->allocator, (p->bone_count + 1) * sizeof *p->joint_bones, POSE__ALIGN);
+    p->joint_spheres = pose__alloc(&p->allocator, (8 * nj + 1) * sizeof *p->joint_spheres, POSE__ALIGN);
+    if (!p->joint_start || !p->joint_bones || !p->joint_spheres)
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu joints", nj);
+    for (size_t j = 0; j < p->bone_count; j++)
+        p->joint_start[p->bones[j].joint + 1]++;
+    for (size_t k = 0; k < nj; k++)
+        p->joint_start[k + 1] += p->joint_start[k];
+    for (size_t j = 0; j < p->bone_count; j++) /* in the rig's order within each joint */
+        p->joint_bones[p->joint_start[p->bones[j].joint]++] = (uint32_t)j;
+    for (size_t k = nj; k > 0; k--) /* the pass above moved each start to the next one's */
+        p->joint_start[k] = p->joint_start[k - 1];
+    p->joint_start[0] = 0;
+    for (size_t k = 0; k < nj; k++) {
+        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, *js = p->joint_spheres + 8 * k;
+        for (uint32_t e = p->joint_start[k]; e < p->joint_start[k + 1]; e++) {
+            const pose__push_bone *b = &p->bones[p->joint_bones[e]];
+            for (int d = 0; d < 3; d++) {
+                lo[d] = fminf(lo[d], b->center[d] - b->radius);
+                hi[d] = fmaxf(hi[d], b->center[d] + b->radius);
+            }
+        }
+        float r = 0.0f;
+        for (int d = 0; d < 3; d++)
+            js[d] = p->joint_start[k + 1] > p->joint_start[k] ? 0.5f * (lo[d] + hi[d]) : 0.0f;
+        for (uint32_t e = p->joint_start[k]; e < p->joint_start[k + 1]; e++) {
+            const pose__push_bone *b = &p->bones[p->joint_bones[e]];
+            const float dx = b->center[0] - js[0], dy = b->center[1] - js[1], dz = b->center[2] - js[2];
+            r = fmaxf(r, sqrtf(dx * dx + dy * dy + dz * dz) + b->radius);
+        }
+        js[3] = p->joint_start[k + 1] > p->joint_start[k] ? r * 1.0001f : -INFINITY; /* none: never near */
+        memcpy(js + 4, js, 4 * sizeof *js);
+    }
+    return POSE_OK;
+}
+
 void pose__push_release(pose__push *p)
 {
     const pose_allocator *a = &p->allocator;
@@ -533,6 +575,14 @@ void pose__push_release(pose__push *p)
     pose__free(a, p->frames);
     pose__free(a, p->bone_spheres);
     pose__free(a, p->near);
+    pose__free(a, p->hit);
+    pose__free(a, p->joint_motion);
+    pose__free(a, p->bound);
+    pose__free(a, p->joint_start);
+    pose__free(a, p->joint_bones);
+    pose__free(a, p->joint_spheres);
+    pose__quiet_release(&p->skin_quiet, a);
+    pose__quiet_release(&p->node_quiet, a);
     pose__free(a, p->nodes);
     pose__free(a, p->node_cache);
     pose__free(a, p->node_bone);
@@ -564,7 +614,11 @@ pose_status pose__push_build(pose__push *p, const pose_state *st, float margin)
     p->bone_words = (nb + 63) / 64;
     p->bone_spheres = pose__alloc(&p->allocator, (4 * 64 * p->bone_words + 1) * sizeof(float), POSE__ALIGN);
     p->near = pose__alloc(&p->allocator, (POSE__PUSH_ITEMS * nb + 1) * sizeof *p->near, POSE__ALIGN);
-    if (!p->bones || !p->frames || !p->bone_spheres || !p->near)
+    p->hit = pose__alloc(&p->allocator, POSE__PUSH_ITEMS * nb + 1, POSE__ALIGN);
+    p->joint_count = rig->joint_count;
+    p->joint_motion = pose__calloc(&p->allocator, (p->joint_count + 1) * sizeof *p->joint_motion, POSE__ALIGN);
+    p->bound = pose__alloc(&p->allocator, (POSE__PUSH_ITEMS * p->joint_count + 1) * sizeof *p->bound, POSE__ALIGN);
+    if (!p->bones || !p->frames || !p->bone_spheres || !p->near || !p->hit || !p->joint_motion || !p->bound)
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu bones", nb);
     for (size_t j = 0; j < 4 * 64 * p->bone_words; j++) /* the padding never near (x infinite) */
         p->bone_spheres[j] = j < 64 * p->bone_words ? INFINITY : 0.0f;
@@ -583,7 +637,11 @@ pose_status pose__push_build(pose__push *p, const pose_state *st, float margin)
             s = bone_grid(b, ts, margin, &p->allocator);
     }
     if (s == POSE_OK)
+        s = joint_spheres(p);
+    if (s == POSE_OK)
         s = skin_order(p, st);
+    if (s == POSE_OK)
+        s = pose__quiet_build(&p->skin_quiet, p->cluster_count, p->joint_count, &p->allocator);
     if (s != POSE_OK)
         return s;
     mark_rest_inside(p, st);
@@ -607,7 +665,7 @@ static int rest_gap(const pose__push *p, const float *x, uint16_t *bone, float *
     *gap = INFINITY;
     for (size_t j = 0; j < p->bone_count && j < UINT16_MAX; j++) {
         float sd, c[3], o[3];
-        if (!pose__push_query(p, &p->bones[j], identity, x, NULL, &sd, c, o))
+        if (!pose__push_query(p, &p->bones[j], identity, x, NULL, &sd, c, o, NULL))
             continue;
         if (sd < 0.0f)
             return 1;
@@ -666,8 +724,11 @@ pose_status pose__push_build_nodes(pose__push *p, const pose_state *st)
     }
     p->node_count = kept;
     p->node_clusters = (kept + POSE__PUSH_CLUSTER - 1) / POSE__PUSH_CLUSTER;
+    pose__free(a, k);
+    const pose_status s = pose__quiet_build(&p->node_quiet, p->node_clusters, p->joint_count, a);
+    if (s != POSE_OK)
+        return s;
     pose__push_forget(p, nv);
     p->nodes_built = 1;
-    pose__free(a, k);
     return POSE_OK;
 }

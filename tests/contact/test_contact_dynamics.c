@@ -184,7 +184,16 @@ typedef struct run_result {
     double impulse_max, contact_ms, step_ms;
     double cg_rest;               /* CG iterations per step over the hold's second half */
     float *ramp_tets;             /* tet positions after the ramp (malloc) */
+    float *end_tets, *end_skin;   /* tet and skin positions at the end (malloc, with a hold) */
+    double held_nodes, held_skin; /* clusters left as they were (contact_quiet.h), of all, over the hold */
 } run_result;
+
+static void release(run_result *r)
+{
+    free(r->ramp_tets);
+    free(r->end_tets);
+    free(r->end_skin);
+}
 
 static pose_state *new_state(int threads, int contact)
 {
@@ -206,9 +215,13 @@ static void set_fraction(pose_state *st, double s)
     }
 }
 
-static run_result run(int threads, int contact, int hold)
+/* With `full`, every cluster's pass of the response in full (none left
+ * quiet: contact_quiet.h). */
+static run_result run(int threads, int contact, int hold, int full)
 {
     pose_state *st = new_state(threads, contact);
+    if (contact)
+        st->push->quiet_off = full;
     assert_true(pose_set_neutral(st) >= 0);
     assert_int_equal(pose_reset_dynamics(st), POSE_OK);
     run_result r = {0};
@@ -249,6 +262,11 @@ static run_result run(int threads, int contact, int hold)
                 r.excess = fmax(r.excess, st->push->max_excess[i]);
                 r.moved = fmax(r.moved, st->push->max_move[i]);
             }
+            const pose__push *p = st->push;
+            if (k > RAMP_STEPS) {
+                r.held_nodes += (double)pose__quiet_held(&p->node_quiet) / (double)p->node_clusters / hold;
+                r.held_skin += (double)pose__quiet_held(&p->skin_quiet) / (double)p->cluster_count / hold;
+            }
         } else {
             assert_int_equal(ds.contacts, 0);
         }
@@ -263,6 +281,11 @@ static run_result run(int threads, int contact, int hold)
     if (hold) {
         r.nodes_end = count_nodes(st, pose_tet_positions(st, NULL), NULL);
         r.skin_end = count_skin(st, &r.any_end);
+        r.end_tets = malloc(3 * tv * sizeof(float));
+        r.end_skin = malloc(3 * g.skin_count * sizeof(float));
+        assert_true(r.end_tets && r.end_skin);
+        memcpy(r.end_tets, pose_tet_positions(st, NULL), 3 * tv * sizeof(float));
+        memcpy(r.end_skin, pose_tissue_positions(st, g.skin, NULL), 3 * g.skin_count * sizeof(float));
     }
     r.contact_ms = 1e3 * contact_s / (RAMP_STEPS + hold);
     r.step_ms = 1e3 * step_s / (RAMP_STEPS + hold);
@@ -291,7 +314,7 @@ static void knees_and_elbows(void **unused)
         soft += g.soft[v];
     printf("%zu soft nodes of %zu tet vertices, %zu inside bone at rest (not counted)\n", soft,
            g.tet.vertex_count, rest_nodes);
-    run_result off = run(2, 0, HOLD_STEPS), on = run(2, 1, HOLD_STEPS), one = run(1, 1, 0);
+    run_result off = run(2, 0, HOLD_STEPS, 0), on = run(2, 1, HOLD_STEPS, 0), one = run(1, 1, 0, 0);
     printf("knee 140, elbow 145 (ramp %.2f s, held %.2f s), soft nodes in bone: off %zu / %zu (after "
            "the ramp / at the end), on %zu / %zu; skin vertices in a bone they cover: off %zu / %zu, on %zu / %zu "
            "(in any bone: off %zu / %zu, on %zu / %zu)\n",
@@ -328,9 +351,55 @@ static void knees_and_elbows(void **unused)
     assert_true(on.cg_rest <= off.cg_rest + 2.0);
     /* 1 and 2 threads: the same bits */
     assert_memory_equal(on.ramp_tets, one.ramp_tets, 3 * g.tet.vertex_count * sizeof(float));
-    free(off.ramp_tets);
-    free(on.ramp_tets);
-    free(one.ramp_tets);
+    release(&off);
+    release(&on);
+    release(&one);
+}
+
+/* Clusters left as they were while nothing near them has moved enough to
+ * matter (contact_quiet.h) give the same bits as every cluster's pass in
+ * full: in pose_step's ramp and hold, and in pose_apply through a sweep of
+ * the knees and elbows in 1 degree steps; and held, most clusters are
+ * left. */
+static void quiet_is_exact(void **unused)
+{
+    (void)unused;
+    run_result quiet = run(2, 1, HOLD_STEPS, 0), full = run(2, 1, HOLD_STEPS, 1);
+    printf("pose_step: clusters left quiet over the hold: nodes %.1f %%, skin %.1f %%\n", 100.0 * quiet.held_nodes,
+           100.0 * quiet.held_skin);
+    assert_memory_equal(quiet.ramp_tets, full.ramp_tets, 3 * g.tet.vertex_count * sizeof(float));
+    assert_memory_equal(quiet.end_tets, full.end_tets, 3 * g.tet.vertex_count * sizeof(float));
+    assert_memory_equal(quiet.end_skin, full.end_skin, 3 * g.skin_count * sizeof(float));
+    assert_true(full.held_nodes == 0.0 && full.held_skin == 0.0);
+    assert_true(quiet.held_nodes > 0.5 && quiet.held_skin > 0.5);
+    release(&quiet);
+    release(&full);
+
+    pose_state *st[2];
+    double held = 0.0;
+    int frames = 0;
+    for (int k = 0; k < 2; k++) {
+        pose_state_options so = {.size = sizeof so, .threads = 2, .method = POSE_DQS};
+        assert_int_equal(pose_state_create_ex(g.rig, &so, &st[k]), POSE_OK);
+        pose_contact_response r = {.size = sizeof r, .enabled = 1};
+        assert_int_equal(pose_set_contact_response(st[k], &r), POSE_OK);
+        st[k]->push->quiet_off = k;
+        assert_true(pose_set_neutral(st[k]) >= 0);
+    }
+    for (double s = 0.0; s <= 1.0 + 1e-9; s += 1.0 / 145.0, frames++) {
+        for (int k = 0; k < 2; k++) {
+            set_fraction(st[k], s);
+            assert_int_equal(pose_apply(st[k]), POSE_OK);
+        }
+        assert_memory_equal(pose_tissue_positions(st[0], g.skin, NULL), pose_tissue_positions(st[1], g.skin, NULL),
+                            3 * g.skin_count * sizeof(float));
+        held += (double)pose__quiet_held(&st[0]->push->skin_quiet) / (double)st[0]->push->cluster_count;
+    }
+    printf("pose_apply, knees and elbows swept in 1 degree steps: skin clusters left quiet %.1f %%\n",
+           100.0 * held / frames);
+    assert_true(held > 0.0);
+    pose_state_free(st[0]);
+    pose_state_free(st[1]);
 }
 
 /* The ramp with the response on, 1 and 2 threads: the same bits (the
@@ -338,17 +407,18 @@ static void knees_and_elbows(void **unused)
 static void threads(void **unused)
 {
     (void)unused;
-    run_result two = run(2, 1, 0), one = run(1, 1, 0);
+    run_result two = run(2, 1, 0, 0), one = run(1, 1, 0, 0);
     assert_true(two.contacts_max > 0);
     assert_memory_equal(two.ramp_tets, one.ramp_tets, 3 * g.tet.vertex_count * sizeof(float));
-    free(two.ramp_tets);
-    free(one.ramp_tets);
+    release(&two);
+    release(&one);
 }
 
 int main(int argc, char **argv)
 {
     const struct CMUnitTest all[] = {
         cmocka_unit_test(knees_and_elbows),
+        cmocka_unit_test(quiet_is_exact),
     };
     const struct CMUnitTest only_threads[] = {
         cmocka_unit_test(threads),
