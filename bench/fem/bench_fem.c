@@ -24,7 +24,10 @@
  * --contact N: N rounds of the dynamics without and with the contact
  * response (pose/contact.h: soft nodes kept out of bone by velocity
  * constraints in the step, the skin pushed out of bone after it),
- * alternately, and the ratio of their wall times per step.
+ * alternately, and the ratio of their wall times per step; the passes'
+ * own timers, and the share of clusters they left quiet (contact_quiet.h:
+ * nothing near them moved enough to matter). --steps 120 keeps to the
+ * swing; the default 480 holds the rest posture 3 s after it.
  *
  *   fem RIG [--threads N] [--reps N] [--tolerance T] [--outer N] [--steps N]
  *           [--dynamics-only] [--contact N]

@@ -262,7 +262,7 @@ static void contact_item(void *ctx, size_t item)
         /* a quiet cluster (contact_quiet.h) has no constraint: its nodes'
          * resting contacts are updated as the full pass would */
         const int quiet =
-            !p->quiet_off && pose__quiet_holds(&p->node_quiet, p->joint_motion, p->margin, c, &y[0][0], NULL, count);
+            !p->quiet_off && pose__quiet_holds(&p->node_quiet, &p->quiet_joints, p->margin, c, &y[0][0], NULL, count);
         if (!quiet) {
             pose__quiet_begin(&p->node_quiet, c, &y[0][0], NULL, count);
             for (size_t k = 0; k < p->joint_count; k++)
@@ -307,7 +307,7 @@ static void contact_item(void *ctx, size_t item)
             }
         }
         if (!quiet)
-            pose__quiet_end(&p->node_quiet, p->joint_motion, c, bound);
+            pose__quiet_end(&p->node_quiet, &p->quiet_joints, c, count, bound);
         for (size_t i = 0; i < count; i++) {
             const size_t v = p->nodes[vb + i];
             const float *b = pre + 6 * v, s = (b[0] + b[3] + b[5]) * (1.0f / 3.0f);

@@ -16,38 +16,22 @@
  * (rig units; metres for pose-bake's rigs). */
 #define DEFAULT_MARGIN 0.0005f
 
-/* The bones' frames for the pose, and each joint's running move
- * (contact_quiet.h): the farthest any point of its bones' rest spheres
- * went from the last frames to these, |R' - R| r + the centre's move
- * (|R' - R| by its Frobenius norm, which bounds the spectral one; with
- * room for rounding wherever a frame changed). */
+/* The bones' frames for the pose, their posed spheres and joints'
+ * spheres, and the joints' running moves (contact_quiet.h). */
 void pose__state_push_frames(pose_state *st)
 {
     pose__push *p = st->push;
     const size_t stride = 64 * p->bone_words;
-    float *step = p->bound; /* the items' scratch: no item runs now */
-    for (size_t k = 0; k < p->joint_count; k++)
-        step[k] = 0.0f;
     for (size_t j = 0; j < p->bone_count; j++) {
         const pose__push_bone *b = &p->bones[j];
         const pose__xform *m = &st->skin[b->joint];
-        float *f = p->frames + 12 * j, was[12], rot = 0.0f, moved = 0.0f;
-        memcpy(was, f, sizeof was);
+        float *f = p->frames + 12 * j;
         pose__quat_to_matrix(m->q, f);
         memcpy(f + 9, m->t, 3 * sizeof(float));
-        for (int k = 0; k < 9; k++)
-            rot += (f[k] - was[k]) * (f[k] - was[k]);
-        for (int r = 0; r < 3; r++) {
-            float *c = p->bone_spheres + (size_t)r * stride + j;
-            const float now = f[3 * r] * b->center[0] + f[3 * r + 1] * b->center[1] + f[3 * r + 2] * b->center[2] + f[9 + r];
-            moved += (now - *c) * (now - *c);
-            *c = now;
-        }
+        for (int r = 0; r < 3; r++)
+            p->bone_spheres[(size_t)r * stride + j] =
+                f[3 * r] * b->center[0] + f[3 * r + 1] * b->center[1] + f[3 * r + 2] * b->center[2] + f[9 + r];
         p->bone_spheres[3 * stride + j] = b->radius;
-        if (rot > 0.0f || moved > 0.0f) {
-            const float move = (sqrtf(rot) + 1e-6f) * b->radius + sqrtf(moved) + 1e-6f;
-            step[b->joint] = move > step[b->joint] ? move : step[b->joint];
-        }
     }
     for (size_t k = 0; k < p->joint_count; k++) {
         if (p->joint_start[k + 1] == p->joint_start[k])
@@ -55,10 +39,8 @@ void pose__state_push_frames(pose_state *st)
         const float *f = p->frames + 12 * (size_t)p->joint_bones[p->joint_start[k]], *c = p->joint_spheres + 8 * k;
         for (int r = 0; r < 3; r++)
             p->joint_spheres[8 * k + 4 + (size_t)r] = f[3 * r] * c[0] + f[3 * r + 1] * c[1] + f[3 * r + 2] * c[2] + f[9 + r];
-        if (p->frames_set)
-            p->joint_motion[k] += step[k];
     }
-    p->frames_set = 1;
+    pose__quiet_joints_update(&p->quiet_joints, st->skin, p->joint_spheres);
 }
 
 /* x (posed) into the bone's rest frame: R^T (x - t). */
@@ -391,7 +373,7 @@ void pose__state_push_item(void *ctx, size_t item)
     for (size_t c = cb; c < ce; c++) {
         const size_t vb = c * POSE__PUSH_CLUSTER,
                      ve = vb + POSE__PUSH_CLUSTER < p->vertex_count ? vb + POSE__PUSH_CLUSTER : p->vertex_count;
-        if (!p->quiet_off && pose__quiet_holds(&p->skin_quiet, p->joint_motion, p->margin, c,
+        if (!p->quiet_off && pose__quiet_holds(&p->skin_quiet, &p->quiet_joints, p->margin, c,
                                                st->tissue_positions, p->order + vb, ve - vb))
             continue;
         pose__quiet_begin(&p->skin_quiet, c, st->tissue_positions, p->order + vb, ve - vb);
@@ -430,7 +412,7 @@ void pose__state_push_item(void *ctx, size_t item)
                 }
             }
         }
-        pose__quiet_end(&p->skin_quiet, p->joint_motion, c, bound);
+        pose__quiet_end(&p->skin_quiet, &p->quiet_joints, c, ve - vb, bound);
     }
     p->pushed[item] = pushed;
     p->max_push[item] = most;

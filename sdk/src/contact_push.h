@@ -116,9 +116,7 @@ typedef struct pose__push {
     uint32_t *near;         /**< per item: scratch for pose__push_near_bones, bone_count entries */
     uint8_t *hit;           /**< per item: its scratch too, bone_count bytes */
     size_t joint_count;     /**< the rig's joints */
-    double *joint_motion;   /**< per joint: how far its bones have moved, summed over the
-                                 frames (pose__state_push_frames; contact_quiet.h) */
-    int frames_set;         /**< frames holds a pose (the next one's move is measured from it) */
+    pose__quiet_joints quiet_joints; /**< the joints' frames and moves (contact_quiet.h) */
     float *bound;           /**< per item: scratch, a bound per joint (contact_quiet.h) */
     uint32_t *joint_start;  /**< per joint + 1: where its bones start in joint_bones */
     uint32_t *joint_bones;  /**< bones (indices in bones) joint by joint */

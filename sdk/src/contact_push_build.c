@@ -576,7 +576,7 @@ void pose__push_release(pose__push *p)
     pose__free(a, p->bone_spheres);
     pose__free(a, p->near);
     pose__free(a, p->hit);
-    pose__free(a, p->joint_motion);
+    pose__quiet_joints_release(&p->quiet_joints, a);
     pose__free(a, p->bound);
     pose__free(a, p->joint_start);
     pose__free(a, p->joint_bones);
@@ -616,9 +616,8 @@ pose_status pose__push_build(pose__push *p, const pose_state *st, float margin)
     p->near = pose__alloc(&p->allocator, (POSE__PUSH_ITEMS * nb + 1) * sizeof *p->near, POSE__ALIGN);
     p->hit = pose__alloc(&p->allocator, POSE__PUSH_ITEMS * nb + 1, POSE__ALIGN);
     p->joint_count = rig->joint_count;
-    p->joint_motion = pose__calloc(&p->allocator, (p->joint_count + 1) * sizeof *p->joint_motion, POSE__ALIGN);
     p->bound = pose__alloc(&p->allocator, (POSE__PUSH_ITEMS * p->joint_count + 1) * sizeof *p->bound, POSE__ALIGN);
-    if (!p->bones || !p->frames || !p->bone_spheres || !p->near || !p->hit || !p->joint_motion || !p->bound)
+    if (!p->bones || !p->frames || !p->bone_spheres || !p->near || !p->hit || !p->bound)
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu bones", nb);
     for (size_t j = 0; j < 4 * 64 * p->bone_words; j++) /* the padding never near (x infinite) */
         p->bone_spheres[j] = j < 64 * p->bone_words ? INFINITY : 0.0f;
@@ -638,6 +637,8 @@ pose_status pose__push_build(pose__push *p, const pose_state *st, float margin)
     }
     if (s == POSE_OK)
         s = joint_spheres(p);
+    if (s == POSE_OK)
+        s = pose__quiet_joints_build(&p->quiet_joints, p->joint_count, &p->allocator);
     if (s == POSE_OK)
         s = skin_order(p, st);
     if (s == POSE_OK)

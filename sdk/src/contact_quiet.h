@@ -6,19 +6,25 @@
  * A full pass of a cluster (of skin vertices or of soft nodes) ends with a
  * lower bound on the distance from each of its points to each joint's
  * bones, which its tests found on the way (spheres apart, the grids'
- * gaps, the queries' distances). Until the next full pass, a point's
- * distance to a bone can shrink by no more than the point's move since
- * then plus the bone's: so while, for every joint,
+ * gaps, the queries' distances). Distances do not depend on the frame they
+ * are measured in, so the cluster keeps its points in the frame of one
+ * joint R (the one whose bones were nearest): until the next full pass, a
+ * point's distance to joint J's bones can shrink by no more than the
+ * point's move in R's frame plus J's bones' move in R's frame. So while,
+ * for every joint J,
  *
- *     bound - (the joint's bones' move since) - (the farthest point's move) > margin,
+ *     bound_J - (J's bones' move in R's frame since) - (the farthest point's move in R's frame) > margin,
  *
- * no point of the cluster is within the margin of a bone, and the full
- * pass would change nothing (no push, no constraint). A joint's move is a
- * running sum over the bones' frames (pose__state_push_frames) of how far
- * any point of its bones' rest spheres moved between consecutive frames,
- * so the test is one subtraction a joint and one distance a point. A
- * posture held still costs almost nothing after its first step; what
- * moves is searched as before. */
+ * no point of the cluster is within the margin of a bone (nor inside one:
+ * it was outside, and nothing came nearer than the margin on the way), and
+ * the full pass would change nothing (no push, no constraint). A joint's
+ * move in another's frame is a running sum over the frames
+ * (pose__quiet_joints_update) of how far any point of its bones' sphere
+ * moved in that frame between consecutive frames, so the test is one
+ * subtraction a joint and one transform a point. Skin riding on a moving
+ * limb is quiet in the limb's frame; a posture held still costs almost
+ * nothing after its first step; what moves near bone is searched as
+ * before. */
 #ifndef POSE_CONTACT_QUIET_H
 #define POSE_CONTACT_QUIET_H
 
@@ -28,31 +34,48 @@
 
 #include "alloc.h"
 #include "pose/pose.h"
+#include "rt_quat.h"
+
+/** The joints' frames and their running moves in each other's frames. */
+typedef struct pose__quiet_joints {
+    size_t count;
+    int set;         /**< the frames hold a pose (the next one's move is measured from it) */
+    float *frames;   /**< per joint: rotation (9, row-major) and translation (3), posed */
+    float *pairs;    /**< per joint pair (R, J): J's rotation in R's frame (quaternion) and its
+                          bones' sphere's centre there, at the last frames (7) */
+    double *motion;  /**< per pair (R, J), R * count + J: J's bones' running move in R's frame */
+} pose__quiet_joints;
 
 typedef struct pose__quiet {
     size_t clusters, joints;
-    float *points;  /**< per cluster, POSE__PUSH_CLUSTER x 3: its points at its last full pass */
-    double *clear;  /**< per cluster, per joint: the bound then plus the joint's running move
-                         then (-INFINITY: no full pass yet) */
-    uint8_t *held;  /**< per cluster: the last pass left it as it was (quiet) */
+    float *points;   /**< per cluster, POSE__PUSH_CLUSTER x 3: its points at its last full pass,
+                          in its joint's frame (at rest) */
+    int32_t *frame;  /**< per cluster: that joint, R; -1: no full pass yet */
+    double *clear;   /**< per cluster, per joint J: the bound then plus J's running move in R's
+                          frame then */
+    uint8_t *held;   /**< per cluster: the last pass left it as it was (quiet) */
 } pose__quiet;
+
+pose_status pose__quiet_joints_build(pose__quiet_joints *qj, size_t joints, const pose_allocator *a);
+void pose__quiet_joints_release(pose__quiet_joints *qj, const pose_allocator *a);
+/** New frames (skin: rest -> posed per joint); each joint's bones lie in
+ *  the sphere spheres[8 j .. 8 j + 3] at rest (centre, radius; radius
+ *  -INFINITY: no bones). */
+void pose__quiet_joints_update(pose__quiet_joints *qj, const pose__xform *skin, const float *spheres);
 
 /** Room for `clusters` clusters of the rig's `joints` joints, none quiet. */
 pose_status pose__quiet_build(pose__quiet *q, size_t clusters, size_t joints, const pose_allocator *a);
 void pose__quiet_release(pose__quiet *q, const pose_allocator *a);
-/** Forget every cluster's last pass (the next pass of each is full). */
-void pose__quiet_forget(pose__quiet *q);
 /** Whether cluster c, whose points are now pos[3 idx[i]] (pos[3 i] when
  *  idx is NULL), i < count, is still farther than the margin from every
- *  bone, given the joints' running moves `motion` (recorded in held). */
-int pose__quiet_holds(pose__quiet *q, const double *motion, float margin, size_t c, const float *pos,
+ *  bone (recorded in held). */
+int pose__quiet_holds(pose__quiet *q, const pose__quiet_joints *qj, float margin, size_t c, const float *pos,
                       const uint32_t *idx, size_t count);
 /** A full pass of cluster c starts: its points as the pass finds them. */
 void pose__quiet_begin(pose__quiet *q, size_t c, const float *pos, const uint32_t *idx, size_t count);
 /** ... and ends: `bound` per joint (what the pass proved; INFINITY for a
  *  joint whose bones it had no reason to test). */
-void pose__quiet_end(pose__quiet *q, const double *motion, size_t c, const float *bound);
-
+void pose__quiet_end(pose__quiet *q, const pose__quiet_joints *qj, size_t c, size_t count, const float *bound);
 /** The clusters the last pass held, of all. */
 size_t pose__quiet_held(const pose__quiet *q);
 

@@ -12,7 +12,9 @@
  * per step); the kinetic energy decays after the stop; held, the nodes
  * resting on bone cost the solve at most 2 more CG iterations a step than
  * the same run without contact; 1 and 2 threads
- * give the same bits; pose_get_dynamics_stats with the size before the
+ * give the same bits; clusters left quiet (contact_quiet.h) give the same
+ * bits as every pass in full, in pose_step and in pose_apply
+ * (quiet_is_exact); pose_get_dynamics_stats with the size before the
  * contact fields. A rig path is taken from POSE_CONTACT_RIG. */
 #include <math.h>
 #include <setjmp.h>
