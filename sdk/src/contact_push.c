@@ -412,7 +412,7 @@ void pose__state_push_item(void *ctx, size_t item)
                 }
             }
         }
-        pose__quiet_end(&p->skin_quiet, &p->quiet_joints, c, ve - vb, bound);
+        pose__quiet_end(&p->skin_quiet, &p->quiet_joints, p->margin, c, ve - vb, bound);
     }
     p->pushed[item] = pushed;
     p->max_push[item] = most;

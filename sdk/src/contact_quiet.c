@@ -155,11 +155,15 @@ void pose__quiet_begin(pose__quiet *q, size_t c, const float *pos, const uint32_
         memcpy(then + 3 * i, pos + 3 * (size_t)(idx ? idx[i] : i), 3 * sizeof(float));
 }
 
-void pose__quiet_end(pose__quiet *q, const pose__quiet_joints *qj, size_t c, size_t count, const float *bound)
+void pose__quiet_end(pose__quiet *q, const pose__quiet_joints *qj, float margin, size_t c, size_t count,
+                     const float *bound)
 {
     size_t r = 0; /* the joint whose bones are nearest */
     for (size_t j = 1; j < q->joints; j++)
         r = bound[j] < bound[r] ? j : r;
+    q->frame[c] = -1;
+    if (!(bound[r] > margin)) /* a point near bone: not quiet before its next full pass */
+        return;
     float *then = q->points + 3 * POSE__PUSH_CLUSTER * c;
     for (size_t i = 0; i < count; i++) {
         float y[3];

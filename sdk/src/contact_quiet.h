@@ -74,8 +74,10 @@ int pose__quiet_holds(pose__quiet *q, const pose__quiet_joints *qj, float margin
 /** A full pass of cluster c starts: its points as the pass finds them. */
 void pose__quiet_begin(pose__quiet *q, size_t c, const float *pos, const uint32_t *idx, size_t count);
 /** ... and ends: `bound` per joint (what the pass proved; INFINITY for a
- *  joint whose bones it had no reason to test). */
-void pose__quiet_end(pose__quiet *q, const pose__quiet_joints *qj, size_t c, size_t count, const float *bound);
+ *  joint whose bones it had no reason to test; a bound within the margin:
+ *  not quiet before the next full pass). */
+void pose__quiet_end(pose__quiet *q, const pose__quiet_joints *qj, float margin, size_t c, size_t count,
+                     const float *bound);
 /** The clusters the last pass held, of all. */
 size_t pose__quiet_held(const pose__quiet *q);
 
