@@ -307,7 +307,7 @@ static void contact_item(void *ctx, size_t item)
             }
         }
         if (!quiet)
-            pose__quiet_end(&p->node_quiet, &p->quiet_joints, p->margin, c, count, bound);
+            pose__quiet_end(&p->node_quiet, &p->quiet_joints, p->margin, c, bound);
         for (size_t i = 0; i < count; i++) {
             const size_t v = p->nodes[vb + i];
             const float *b = pre + 6 * v, s = (b[0] + b[3] + b[5]) * (1.0f / 3.0f);

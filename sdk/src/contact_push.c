@@ -295,6 +295,15 @@ int pose__push_sphere_far(const pose__push *p, size_t j, const float *sphere, fl
     return 0;
 }
 
+int pose__push_group_near(const pose__push *p, size_t j, const float *group, float *bound)
+{
+    if (!pose__push_spheres_near(p, j, group)) {
+        pose__push_spheres_bound(p, j, group, bound);
+        return 0;
+    }
+    return !pose__push_sphere_far(p, j, group, bound);
+}
+
 /* How far a joint's sphere may lie from a cluster's for its gap to stand
  * for its bones' in the cluster's quiet bound (rig units: 30 mm), instead
  * of each bone's own: a cluster stays quiet that long either way. */
@@ -412,7 +421,7 @@ void pose__state_push_item(void *ctx, size_t item)
                 }
             }
         }
-        pose__quiet_end(&p->skin_quiet, &p->quiet_joints, p->margin, c, ve - vb, bound);
+        pose__quiet_end(&p->skin_quiet, &p->quiet_joints, p->margin, c, bound);
     }
     p->pushed[item] = pushed;
     p->max_push[item] = most;

@@ -216,14 +216,7 @@ static inline void pose__push_spheres_bound(const pose__push *p, size_t j, const
 /** Whether a group's posed sphere may hold a point bone j needs tested
  *  (bones' spheres, then the grid's); if not, what the test proved, into
  *  bound (per joint, or NULL). */
-static inline int pose__push_group_near(const pose__push *p, size_t j, const float *group, float *bound)
-{
-    if (!pose__push_spheres_near(p, j, group)) {
-        pose__push_spheres_bound(p, j, group, bound);
-        return 0;
-    }
-    return !pose__push_sphere_far(p, j, group, bound);
-}
+int pose__push_group_near(const pose__push *p, size_t j, const float *group, float *bound);
 /** The bones a cluster's posed bounding sphere may need tested against,
  *  in the rig's order, into item's near; their count. With mask (a bit per
  *  bone, bone_words words), only those it marks. Each bone's posed sphere

@@ -92,9 +92,10 @@ pose_status pose__quiet_build(pose__quiet *q, size_t clusters, size_t joints, co
     q->joints = joints;
     q->points = pose__alloc(a, (3 * POSE__PUSH_CLUSTER * clusters + 1) * sizeof *q->points, POSE__ALIGN);
     q->frame = pose__alloc(a, (clusters + 1) * sizeof *q->frame, POSE__ALIGN);
+    q->frame_then = pose__alloc(a, (12 * clusters + 1) * sizeof *q->frame_then, POSE__ALIGN);
     q->clear = pose__alloc(a, (clusters * joints + 1) * sizeof *q->clear, POSE__ALIGN);
     q->held = pose__calloc(a, clusters + 1, POSE__ALIGN);
-    if (!q->points || !q->frame || !q->clear || !q->held)
+    if (!q->points || !q->frame || !q->frame_then || !q->clear || !q->held)
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu clusters of the contact response", clusters);
     for (size_t c = 0; c < clusters; c++)
         q->frame[c] = -1;
@@ -105,6 +106,7 @@ void pose__quiet_release(pose__quiet *q, const pose_allocator *a)
 {
     pose__free(a, q->points);
     pose__free(a, q->frame);
+    pose__free(a, q->frame_then);
     pose__free(a, q->clear);
     pose__free(a, q->held);
     memset(q, 0, sizeof *q);
@@ -126,14 +128,25 @@ int pose__quiet_holds(pose__quiet *q, const pose__quiet_joints *qj, float margin
     room -= (double)margin + QUIET_SLACK;
     if (!(room > 0.0))
         return 0;
-    /* the farthest point's move in R's frame, against the room left (squared) */
-    const float *then = q->points + 3 * POSE__PUSH_CLUSTER * c, *f = qj->frames + 12 * (size_t)r;
+    /* the farthest point's move in R's frame, against the room left
+     * (squared): |x - T x_then|, T = F_R(now) F_R(then)^-1 = (M, b) */
+    const float *then = q->points + 3 * POSE__PUSH_CLUSTER * c, *f = qj->frames + 12 * (size_t)r,
+                *g = q->frame_then + 12 * c;
+    float m[9], b[3];
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+            m[3 * i + k] = f[3 * i] * g[3 * k] + f[3 * i + 1] * g[3 * k + 1] + f[3 * i + 2] * g[3 * k + 2];
+    for (int i = 0; i < 3; i++)
+        b[i] = f[9 + i] - (m[3 * i] * g[9] + m[3 * i + 1] * g[10] + m[3 * i + 2] * g[11]);
     const float room2 = (float)(room * room);
     for (size_t i = 0; i < count; i++) {
-        float y[3];
-        to_frame(f, pos + 3 * (size_t)(idx ? idx[i] : i), y);
-        const float dx = y[0] - then[3 * i], dy = y[1] - then[3 * i + 1], dz = y[2] - then[3 * i + 2];
-        if (!(dx * dx + dy * dy + dz * dz < room2))
+        const float *x = pos + 3 * (size_t)(idx ? idx[i] : i), *y = then + 3 * i;
+        float d2 = 0.0f;
+        for (int e = 0; e < 3; e++) {
+            const float d = x[e] - (m[3 * e] * y[0] + m[3 * e + 1] * y[1] + m[3 * e + 2] * y[2] + b[e]);
+            d2 += d * d;
+        }
+        if (!(d2 < room2))
             return 0;
     }
     q->held[c] = 1;
@@ -155,8 +168,7 @@ void pose__quiet_begin(pose__quiet *q, size_t c, const float *pos, const uint32_
         memcpy(then + 3 * i, pos + 3 * (size_t)(idx ? idx[i] : i), 3 * sizeof(float));
 }
 
-void pose__quiet_end(pose__quiet *q, const pose__quiet_joints *qj, float margin, size_t c, size_t count,
-                     const float *bound)
+void pose__quiet_end(pose__quiet *q, const pose__quiet_joints *qj, float margin, size_t c, const float *bound)
 {
     size_t r = 0; /* the joint whose bones are nearest */
     for (size_t j = 1; j < q->joints; j++)
@@ -164,13 +176,8 @@ void pose__quiet_end(pose__quiet *q, const pose__quiet_joints *qj, float margin,
     q->frame[c] = -1;
     if (!(bound[r] > margin)) /* a point near bone: not quiet before its next full pass */
         return;
-    float *then = q->points + 3 * POSE__PUSH_CLUSTER * c;
-    for (size_t i = 0; i < count; i++) {
-        float y[3];
-        to_frame(qj->frames + 12 * r, then + 3 * i, y);
-        memcpy(then + 3 * i, y, sizeof y);
-    }
     q->frame[c] = (int32_t)r;
+    memcpy(q->frame_then + 12 * c, qj->frames + 12 * r, 12 * sizeof(float));
     double *clear = q->clear + c * q->joints;
     const double *motion = qj->motion + r * qj->count;
     for (size_t j = 0; j < q->joints; j++)

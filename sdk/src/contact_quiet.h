@@ -48,9 +48,10 @@ typedef struct pose__quiet_joints {
 
 typedef struct pose__quiet {
     size_t clusters, joints;
-    float *points;   /**< per cluster, POSE__PUSH_CLUSTER x 3: its points at its last full pass,
-                          in its joint's frame (at rest) */
-    int32_t *frame;  /**< per cluster: that joint, R; -1: no full pass yet */
+    float *points;   /**< per cluster, POSE__PUSH_CLUSTER x 3: its points at its last full pass */
+    int32_t *frame;  /**< per cluster: the joint R whose bones were nearest then; -1: no full
+                          pass yet, or one that found a point within the margin */
+    float *frame_then; /**< per cluster: R's frame then (rotation, row-major, and translation) */
     double *clear;   /**< per cluster, per joint J: the bound then plus J's running move in R's
                           frame then */
     uint8_t *held;   /**< per cluster: the last pass left it as it was (quiet) */
@@ -76,8 +77,7 @@ void pose__quiet_begin(pose__quiet *q, size_t c, const float *pos, const uint32_
 /** ... and ends: `bound` per joint (what the pass proved; INFINITY for a
  *  joint whose bones it had no reason to test; a bound within the margin:
  *  not quiet before the next full pass). */
-void pose__quiet_end(pose__quiet *q, const pose__quiet_joints *qj, float margin, size_t c, size_t count,
-                     const float *bound);
+void pose__quiet_end(pose__quiet *q, const pose__quiet_joints *qj, float margin, size_t c, const float *bound);
 /** The clusters the last pass held, of all. */
 size_t pose__quiet_held(const pose__quiet *q);
 
