@@ -261,29 +261,33 @@ static void contact_item(void *ctx, size_t item)
         }
         /* a quiet cluster (contact_quiet.h) has no constraint: its nodes'
          * resting contacts are updated as the full pass would */
-        const int quiet =
-            !p->quiet_off && pose__quiet_holds(&p->node_quiet, &p->quiet_joints, p->margin, c, &y[0][0], NULL, count);
-        if (!quiet) {
+        const pose__quiet_pass pass =
+            p->quiet_off ? POSE__QUIET_SEARCH
+                         : pose__quiet_holds(&p->node_quiet, &p->quiet_joints, p->margin, c, &y[0][0], NULL, count);
+        const int quiet = pass == POSE__QUIET_HOLDS;
+        float *bounds = pass == POSE__QUIET_RECORD ? bound : NULL;
+        if (bounds) {
             pose__quiet_begin(&p->node_quiet, c, &y[0][0], NULL, count);
             for (size_t k = 0; k < p->joint_count; k++)
-                bound[k] = INFINITY;
+                bounds[k] = INFINITY;
         }
         const size_t groups = quiet ? 0 : pose__push_spheres(&y[0][0], NULL, 0, count, cluster, group);
         const uint32_t *near = p->near + item * p->bone_count;
-        const size_t near_count = quiet ? 0 : pose__push_near_bones(p, item, cluster, NULL, bound);
+        const size_t near_count = quiet ? 0 : pose__push_near_bones(p, item, cluster, NULL, bounds);
         for (size_t kb = 0; kb < near_count; kb++) {
             const size_t j = near[kb];
             const pose__push_bone *b = &p->bones[j];
             const float *f = p->frames + 12 * j;
             for (size_t g = 0; g < groups; g++) {
-                if (!pose__push_group_near(p, j, group[g], bound))
+                if (!pose__push_group_near(p, j, group[g], bounds))
                     continue;
                 const size_t gb = g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < count ? gb + POSE__PUSH_GROUP : count;
                 for (size_t i = gb; i < ge; i++) {
                     float sd, q[3], out[3], clear = 0.0f;
                     const int hit = nc[i].count < MAX_CONSTRAINTS &&
-                                    pose__push_query(p, b, f, y[i], &p->node_cache[vb + i], &sd, q, out, &clear);
-                    pose__quiet_bound(bound, b->joint, clear);
+                                    pose__push_query(p, b, f, y[i], &p->node_cache[vb + i], &sd, q, out,
+                                                     bounds ? &clear : NULL);
+                    pose__quiet_bound(bounds, b->joint, clear);
                     if (!hit)
                         continue;
                     const float plane = p->node_bone[vb + i] == j ? p->node_gap[vb + i] : p->margin;
@@ -306,8 +310,8 @@ static void contact_item(void *ctx, size_t item)
                 }
             }
         }
-        if (!quiet)
-            pose__quiet_end(&p->node_quiet, &p->quiet_joints, p->margin, c, bound);
+        if (bounds)
+            pose__quiet_end(&p->node_quiet, &p->quiet_joints, p->margin, c, bounds);
         for (size_t i = 0; i < count; i++) {
             const size_t v = p->nodes[vb + i];
             const float *b = pre + 6 * v, s = (b[0] + b[3] + b[5]) * (1.0f / 3.0f);

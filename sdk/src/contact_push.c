@@ -382,12 +382,18 @@ void pose__state_push_item(void *ctx, size_t item)
     for (size_t c = cb; c < ce; c++) {
         const size_t vb = c * POSE__PUSH_CLUSTER,
                      ve = vb + POSE__PUSH_CLUSTER < p->vertex_count ? vb + POSE__PUSH_CLUSTER : p->vertex_count;
-        if (!p->quiet_off && pose__quiet_holds(&p->skin_quiet, &p->quiet_joints, p->margin, c,
-                                               st->tissue_positions, p->order + vb, ve - vb))
+        const pose__quiet_pass pass =
+            p->quiet_off ? POSE__QUIET_SEARCH
+                         : pose__quiet_holds(&p->skin_quiet, &p->quiet_joints, p->margin, c, st->tissue_positions,
+                                             p->order + vb, ve - vb);
+        if (pass == POSE__QUIET_HOLDS)
             continue;
-        pose__quiet_begin(&p->skin_quiet, c, st->tissue_positions, p->order + vb, ve - vb);
-        for (size_t k = 0; k < p->joint_count; k++)
-            bound[k] = INFINITY;
+        float *bounds = pass == POSE__QUIET_RECORD ? bound : NULL;
+        if (bounds) {
+            pose__quiet_begin(&p->skin_quiet, c, st->tissue_positions, p->order + vb, ve - vb);
+            for (size_t k = 0; k < p->joint_count; k++)
+                bounds[k] = INFINITY;
+        }
         float cluster[4], group[GROUPS][4];
         const size_t groups = pose__push_spheres(st->tissue_positions, p->order, vb, ve, cluster, group);
         /* One push per vertex per frame: a vertex pushed out of one bone into
@@ -395,12 +401,12 @@ void pose__state_push_item(void *ctx, size_t item)
          * vertex not yet pushed has not moved: the spheres hold it.) */
         uint8_t done[POSE__PUSH_CLUSTER] = {0};
         const uint32_t *near = p->near + item * p->bone_count;
-        const size_t near_count = pose__push_near_bones(p, item, cluster, p->reach + c * p->bone_words, bound);
+        const size_t near_count = pose__push_near_bones(p, item, cluster, p->reach + c * p->bone_words, bounds);
         for (size_t k = 0; k < near_count; k++) {
             const pose__push_bone *b = &p->bones[near[k]];
             const float *f = p->frames + 12 * (size_t)near[k];
             for (size_t g = 0; g < groups; g++) {
-                if (!pose__push_group_near(p, near[k], group[g], bound))
+                if (!pose__push_group_near(p, near[k], group[g], bounds))
                     continue;
                 const size_t gb = vb + g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < ve ? gb + POSE__PUSH_GROUP : ve;
                 for (size_t i = gb; i < ge; i++) {
@@ -408,8 +414,8 @@ void pose__state_push_item(void *ctx, size_t item)
                         continue;
                     float *x = st->tissue_positions + 3 * (size_t)p->order[i], before[3], clear;
                     memcpy(before, x, sizeof before);
-                    float m = push_vertex(p, b, f, x, &p->cache[i], &clear);
-                    pose__quiet_bound(bound, b->joint, clear);
+                    float m = push_vertex(p, b, f, x, &p->cache[i], bounds ? &clear : NULL);
+                    pose__quiet_bound(bounds, b->joint, clear);
                     done[i - vb] = m > 0.0f;
                     if (m > 0.0f) {
                         /* lifted first: counted by the cover, its whole move here */
@@ -421,7 +427,8 @@ void pose__state_push_item(void *ctx, size_t item)
                 }
             }
         }
-        pose__quiet_end(&p->skin_quiet, &p->quiet_joints, p->margin, c, bound);
+        if (bounds)
+            pose__quiet_end(&p->skin_quiet, &p->quiet_joints, p->margin, c, bounds);
     }
     p->pushed[item] = pushed;
     p->max_push[item] = most;

@@ -12,6 +12,9 @@
 #define QUIET_SLACK 1e-5
 /* ... and on each frame's move where a frame changed. */
 #define MOVE_SLACK 1e-6f
+/* Most doublings of a moving cluster's wait between snapshots (16 passes:
+ * a cluster that stops is quiet again within that many). */
+#define QUIET_BACKOFF 4
 
 pose_status pose__quiet_joints_build(pose__quiet_joints *qj, size_t joints, const pose_allocator *a)
 {
@@ -95,7 +98,9 @@ pose_status pose__quiet_build(pose__quiet *q, size_t clusters, size_t joints, co
     q->frame_then = pose__alloc(a, (12 * clusters + 1) * sizeof *q->frame_then, POSE__ALIGN);
     q->clear = pose__alloc(a, (clusters * joints + 1) * sizeof *q->clear, POSE__ALIGN);
     q->held = pose__calloc(a, clusters + 1, POSE__ALIGN);
-    if (!q->points || !q->frame || !q->frame_then || !q->clear || !q->held)
+    q->wait = pose__calloc(a, clusters + 1, POSE__ALIGN);
+    q->misses = pose__calloc(a, clusters + 1, POSE__ALIGN);
+    if (!q->points || !q->frame || !q->frame_then || !q->clear || !q->held || !q->wait || !q->misses)
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu clusters of the contact response", clusters);
     for (size_t c = 0; c < clusters; c++)
         q->frame[c] = -1;
@@ -109,16 +114,17 @@ void pose__quiet_release(pose__quiet *q, const pose_allocator *a)
     pose__free(a, q->frame_then);
     pose__free(a, q->clear);
     pose__free(a, q->held);
+    pose__free(a, q->wait);
+    pose__free(a, q->misses);
     memset(q, 0, sizeof *q);
 }
 
-int pose__quiet_holds(pose__quiet *q, const pose__quiet_joints *qj, float margin, size_t c, const float *pos,
-                      const uint32_t *idx, size_t count)
+/* Whether the snapshot of cluster c still proves it farther than the
+ * margin from every bone. */
+static int still_clear(const pose__quiet *q, const pose__quiet_joints *qj, float margin, size_t c, const float *pos,
+                       const uint32_t *idx, size_t count)
 {
-    q->held[c] = 0;
     const int32_t r = q->frame[c];
-    if (r < 0)
-        return 0;
     const double *clear = q->clear + c * q->joints, *motion = qj->motion + (size_t)r * qj->count;
     double room = INFINITY;
     for (size_t j = 0; j < q->joints; j++) {
@@ -149,8 +155,24 @@ int pose__quiet_holds(pose__quiet *q, const pose__quiet_joints *qj, float margin
         if (!(d2 < room2))
             return 0;
     }
-    q->held[c] = 1;
     return 1;
+}
+
+pose__quiet_pass pose__quiet_holds(pose__quiet *q, const pose__quiet_joints *qj, float margin, size_t c,
+                                   const float *pos, const uint32_t *idx, size_t count)
+{
+    q->held[c] = 0;
+    if (q->wait[c] > 0) /* the last snapshot failed: a new one when the wait ends */
+        return --q->wait[c] > 0 ? POSE__QUIET_SEARCH : POSE__QUIET_RECORD;
+    if (q->frame[c] >= 0 && still_clear(q, qj, margin, c, pos, idx, count)) {
+        q->held[c] = 1;
+        q->misses[c] = 0;
+        return POSE__QUIET_HOLDS;
+    }
+    /* failed, or no snapshot that could hold (none yet, or a point near bone) */
+    q->misses[c] += q->misses[c] < QUIET_BACKOFF;
+    q->wait[c] = (uint8_t)((1u << q->misses[c]) - 1u);
+    return q->wait[c] > 0 ? POSE__QUIET_SEARCH : POSE__QUIET_RECORD;
 }
 
 size_t pose__quiet_held(const pose__quiet *q)

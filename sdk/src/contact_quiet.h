@@ -55,7 +55,18 @@ typedef struct pose__quiet {
     double *clear;   /**< per cluster, per joint J: the bound then plus J's running move in R's
                           frame then */
     uint8_t *held;   /**< per cluster: the last pass left it as it was (quiet) */
+    uint8_t *wait;   /**< per cluster: passes left before its next snapshot (backoff) */
+    uint8_t *misses; /**< per cluster: tests failed in a row (the backoff's exponent, capped) */
 } pose__quiet;
+
+/** What a pass does with a cluster (pose__quiet_holds). */
+typedef enum pose__quiet_pass {
+    POSE__QUIET_HOLDS,  /**< leave it as it is */
+    POSE__QUIET_RECORD, /**< search it, recording what the search proves (begin, bounds, end) */
+    POSE__QUIET_SEARCH, /**< search it and record nothing: it moved too much of late for a
+                             snapshot to last (a cluster that fails its test k times in a row
+                             records only every 2^k-th pass, k <= QUIET_BACKOFF) */
+} pose__quiet_pass;
 
 pose_status pose__quiet_joints_build(pose__quiet_joints *qj, size_t joints, const pose_allocator *a);
 void pose__quiet_joints_release(pose__quiet_joints *qj, const pose_allocator *a);
@@ -69,8 +80,8 @@ pose_status pose__quiet_build(pose__quiet *q, size_t clusters, size_t joints, co
 void pose__quiet_release(pose__quiet *q, const pose_allocator *a);
 /** Whether cluster c, whose points are now pos[3 idx[i]] (pos[3 i] when
  *  idx is NULL), i < count, is still farther than the margin from every
- *  bone (recorded in held). */
-int pose__quiet_holds(pose__quiet *q, const pose__quiet_joints *qj, float margin, size_t c, const float *pos,
+ *  bone (recorded in held), and if not, whether the pass records it. */
+pose__quiet_pass pose__quiet_holds(pose__quiet *q, const pose__quiet_joints *qj, float margin, size_t c, const float *pos,
                       const uint32_t *idx, size_t count);
 /** A full pass of cluster c starts: its points as the pass finds them. */
 void pose__quiet_begin(pose__quiet *q, size_t c, const float *pos, const uint32_t *idx, size_t count);
