@@ -412,7 +412,7 @@ void pose__state_push_item(void *ctx, size_t item)
                 for (size_t i = gb; i < ge; i++) {
                     if (p->skip[i] || done[i - vb] || p->own_joint[i] == b->joint)
                         continue;
-                    float *x = st->tissue_positions + 3 * (size_t)p->order[i], before[3], clear;
+                    float *x = st->tissue_positions + 3 * (size_t)p->order[i], before[3], clear = 0.0f;
                     memcpy(before, x, sizeof before);
                     float m = push_vertex(p, b, f, x, &p->cache[i], bounds ? &clear : NULL);
                     pose__quiet_bound(bounds, b->joint, clear);
