@@ -14,7 +14,6 @@
 #ifndef POSE_CONTACT_PUSH_H
 #define POSE_CONTACT_PUSH_H
 
-#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 

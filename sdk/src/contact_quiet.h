@@ -7,11 +7,11 @@
  * lower bound on the distance from each of its points to each joint's
  * bones, which its tests found on the way (spheres apart, the grids'
  * gaps, the queries' distances). Distances do not depend on the frame they
- * are measured in, so the cluster keeps its points in the frame of one
- * joint R (the one whose bones were nearest): until the next full pass, a
- * point's distance to joint J's bones can shrink by no more than the
- * point's move in R's frame plus J's bones' move in R's frame. So while,
- * for every joint J,
+ * are measured in, so moves are measured in the frame of one joint R (the
+ * one whose bones were nearest; the cluster keeps its points and R's frame
+ * as they were): until the next full pass, a point's distance to joint J's
+ * bones can shrink by no more than the point's move in R's frame plus J's
+ * bones' move in R's frame. So while, for every joint J,
  *
  *     bound_J - (J's bones' move in R's frame since) - (the farthest point's move in R's frame) > margin,
  *
@@ -24,7 +24,7 @@
  * subtraction a joint and one transform a point. Skin riding on a moving
  * limb is quiet in the limb's frame; a posture held still costs almost
  * nothing after its first step; what moves near bone is searched as
- * before. */
+ * before, and records no bounds while it keeps moving (pose__quiet_pass). */
 #ifndef POSE_CONTACT_QUIET_H
 #define POSE_CONTACT_QUIET_H
 
