@@ -53,6 +53,24 @@ size_t pose__state_transfer_soft(pose_state *st, size_t begin, size_t end, uint3
     return count;
 }
 
+/* count points and normals through (R, t): the matrix in locals and the
+ * arrays restrict, so that no store makes the compiler reload them. */
+static void place_rigid(const float *R, const float *t, const float *restrict r, const float *restrict n,
+                        float *restrict p, float *restrict o, size_t count)
+{
+    const float r00 = R[0], r01 = R[1], r02 = R[2], r10 = R[3], r11 = R[4], r12 = R[5], r20 = R[6], r21 = R[7],
+                r22 = R[8], t0 = t[0], t1 = t[1], t2 = t[2];
+    for (size_t v = 0; v < 3 * count; v += 3) {
+        const float x = r[v], y = r[v + 1], z = r[v + 2], a = n[v], b = n[v + 1], c = n[v + 2];
+        p[v] = r00 * x + r01 * y + r02 * z + t0;
+        p[v + 1] = r10 * x + r11 * y + r12 * z + t1;
+        p[v + 2] = r20 * x + r21 * y + r22 * z + t2;
+        o[v] = r00 * a + r01 * b + r02 * c;
+        o[v + 1] = r10 * a + r11 * b + r12 * c;
+        o[v + 2] = r20 * a + r21 * b + r22 * c;
+    }
+}
+
 void pose__state_place_bones(pose_state *st, size_t begin, size_t end)
 {
     const pose_rig *rig = st->rig;
@@ -66,13 +84,7 @@ void pose__state_place_bones(pose_state *st, size_t begin, size_t end)
         const pose__xform *m = &st->skin[ts->joint];
         float R[9];
         pose__quat_to_matrix(m->q, R);
-        for (size_t v = b; v < e; v++) {
-            const float *r = ts->positions + 3 * (v - offset[t]), *n = st->rt->rest_normals + 3 * v;
-            float *p = st->tissue_positions + 3 * v, *o = st->tissue_normals + 3 * v;
-            for (int a = 0; a < 3; a++) {
-                p[a] = R[3 * a] * r[0] + R[3 * a + 1] * r[1] + R[3 * a + 2] * r[2] + m->t[a];
-                o[a] = R[3 * a] * n[0] + R[3 * a + 1] * n[1] + R[3 * a + 2] * n[2];
-            }
-        }
+        place_rigid(R, m->t, ts->positions + 3 * (b - offset[t]), st->rt->rest_normals + 3 * b,
+                    st->tissue_positions + 3 * b, st->tissue_normals + 3 * b, e - b);
     }
 }
