@@ -124,9 +124,7 @@ pose_status pose_state_create_ex(const pose_rig *rig, const pose_state_options *
     size_t off_flagged = off_nrm + align64(3 * nt * sizeof(float));
     const size_t nt_padded = st_blocks(rig) * POSE__BLOCK;
     size_t off_counts = off_flagged + align64(nt_padded * sizeof(uint32_t));
-    size_t off_fem = off_counts + align64(POSE__MAX_THREADS * sizeof(size_t));
-    const bool fem = pose_rig_has_fem(rig);
-    size_t size = off_fem + (fem ? align64(pose__fem_work_size(&rig->rt->fem)) : 0);
+    size_t size = off_counts + align64(POSE__MAX_THREADS * sizeof(size_t));
 
     pose_allocator alloc = pose__allocator_resolve(&opt.allocator);
     unsigned char *block = pose__alloc(&alloc, size, POSE__ALIGN);
@@ -151,8 +149,6 @@ pose_status pose_state_create_ex(const pose_rig *rig, const pose_state_options *
     st->tissue_normals = (float *)(block + off_nrm);
     st->flagged = (uint32_t *)(block + off_flagged);
     st->flagged_count = (size_t *)(block + off_counts);
-    if (fem)
-        pose__fem_work_init(&rig->rt->fem, block + off_fem, &st->fem_work);
     pose__state_fem_defaults(&st->fem_params);
     pose_dynamics_defaults(&st->dyn_options);
     for (size_t j = 0; j < nj; j++)
@@ -170,6 +166,8 @@ pose_status pose_state_create_ex(const pose_rig *rig, const pose_state_options *
     s = pose__state_couplings_init(st); /* state_coupling.c: the rig's couplings */
     if (s == POSE_OK)
         s = pose__state_links_init(st); /* state_links.c: and its soft-soft ones */
+    if (s == POSE_OK && opt.method == POSE_FEM)
+        s = pose__state_fem_work(st, "pose_state_create");
     if (s < 0) {
         pose_state_free(st);
         return s;
@@ -185,6 +183,8 @@ void pose_state_free(pose_state *st)
     pose_allocator alloc = st->allocator;
     if (st->dyn_block)
         pose__free(&alloc, st->dyn_block);
+    if (st->fem_block)
+        pose__free(&alloc, st->fem_block);
     if (st->pool) {
         pose__pool_destroy(st->pool);
         pose__free(&alloc, st->pool);
@@ -206,6 +206,8 @@ pose_status pose_set_method(pose_state *st, pose_method method)
     if (!st)
         return pose__fail(POSE_ERR_INVALID_ARGUMENT, "pose_set_method: state is NULL");
     pose_status s = check_method(st->rig, method);
+    if (s == POSE_OK && method == POSE_FEM)
+        s = pose__state_fem_work(st, "pose_set_method");
     if (s < 0)
         return s;
     st->method = method;

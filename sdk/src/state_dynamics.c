@@ -59,6 +59,8 @@ static pose_status enable(pose_state *st, const char *fn)
     pose_status s = check_rig(st, fn);
     if (s < 0 || st->dyn_block)
         return s;
+    if ((s = pose__state_fem_work(st, fn)) < 0) /* the solver's work arrays (state_fem.c) */
+        return s;
     const pose__fem_mesh *m = &st->rt->fem;
     uint32_t *island = pose__alloc(&st->allocator, m->vertex_count * sizeof(uint32_t) + 64,
                                    POSE__ALIGN);

@@ -1,9 +1,11 @@
 /* SPDX-License-Identifier: Apache-2.0 */
-/* POSE_FEM on a state: solver settings, statistics, and the refinement
- * pose_apply runs between skinning and transfer. */
+/* POSE_FEM on a state: solver settings, statistics, the solver's work
+ * arrays, and the refinement pose_apply runs between skinning and
+ * transfer. */
 #include <math.h>
 #include <string.h>
 
+#include "alloc.h"
 #include "error.h"
 #include "rt_thread.h"
 #include "state_internal.h"
@@ -78,6 +80,19 @@ pose_status pose_get_fem_stats(const pose_state *st, pose_fem_stats *out)
                           out->size, sizeof(pose_fem_stats));
     *out = st->fem_stats;
     out->size = sizeof(pose_fem_stats);
+    return POSE_OK;
+}
+
+pose_status pose__state_fem_work(pose_state *st, const char *fn)
+{
+    if (st->fem_block)
+        return POSE_OK;
+    const size_t size = pose__fem_work_size(&st->rt->fem);
+    st->fem_block = pose__alloc(&st->allocator, size, POSE__ALIGN);
+    if (!st->fem_block)
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "%s: out of memory for the FEM solver's work (%zu bytes)", fn,
+                          size);
+    pose__fem_work_init(&st->rt->fem, st->fem_block, &st->fem_work);
     return POSE_OK;
 }
 

@@ -41,8 +41,11 @@ struct pose_state {
                                      this frame; part p lists from its first vertex */
     size_t *flagged_count;      /**< per part (POSE__MAX_THREADS) */
 
-    /* POSE_FEM (state_fem.c); work arrays only when the rig has a fem section */
+    /* POSE_FEM and the dynamics (state_fem.c): the solver's work arrays, own
+     * allocation made when first needed (60 floats a soft tet: 406 MB on the
+     * default bake, which a state that only skins should not carry) */
     pose__fem_work fem_work;
+    void *fem_block;            /**< NULL until POSE_FEM or the dynamics are first used */
     pose__fem_params fem_params;
     pose_fem_stats fem_stats;
     /* Dynamics (state_dynamics.c): own allocation, made when first enabled */
@@ -135,6 +138,9 @@ const pose__fem_links *pose__state_links(pose_state *st);
 void pose__state_links_islands(pose_state *st, uint32_t *scratch);
 /** pose_apply's FEM refinement of st->tet_positions (after skinning). */
 void pose__state_fem_refine(pose_state *st);
+/** The solver's work arrays (fem_block), allocated with the state's
+ *  allocator on the first call; POSE_ERR_OUT_OF_MEMORY naming `fn`. */
+pose_status pose__state_fem_work(pose_state *st, const char *fn);
 
 /** Joint rotation setters' shared tail: clamp q to joint j's limits, store it. */
 pose_status pose__state_store_joint(pose_state *st, int joint, float q[4]);

@@ -4,7 +4,8 @@
  * bones joined by soft tissue) settles after a step change of its joint,
  * stays stable under a 360 deg/s swing at dt 1/1000 and 1/30 s, gives the
  * same bits on 1 and 2 threads and allocates nothing per step; the API
- * refuses what it cannot do. */
+ * refuses what it cannot do; the solver's work arrays are allocated on
+ * first use. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -160,11 +161,14 @@ static void test_free_body_momentum(void **state)
 #define LIMB_N 8
 #define LIMB_D 0.015f
 
-static size_t g_allocs;
+static size_t g_allocs, g_largest, g_fail_above; /* g_fail_above 0: never fail */
 static void *count_alloc(size_t size, size_t align, void *user)
 {
     (void)user;
+    if (g_fail_above && size > g_fail_above)
+        return NULL;
     g_allocs++;
+    g_largest = size > g_largest ? size : g_largest;
     void *p = NULL;
     return posix_memalign(&p, align < sizeof(void *) ? sizeof(void *) : align, size) ? NULL : p;
 }
@@ -460,6 +464,57 @@ static void test_api_errors_and_reset(void **state)
     free_box(&small);
 }
 
+/* The solver's work arrays (60 floats a tet and more) are allocated when a
+ * state first needs them: a state that only skins does not carry them
+ * (406 MB on the default bake); pose_set_method(POSE_FEM), a state created
+ * with POSE_FEM and the dynamics' first use allocate them, and an
+ * allocation that fails leaves the state as it was. */
+static void test_fem_work_on_first_use(void **state)
+{
+    (void)state;
+    box b;
+    pose_rig *rig = limb_rig(&b, 1000.0f);
+    assert_non_null(rig);
+    size_t soft = 0; /* the simulation's tets */
+    for (size_t t = 0; t < b.nt; t++)
+        soft += b.labels[t] == 0;
+    const size_t work = 60 * sizeof(float) * soft; /* at least the solver's per-tet arrays */
+    g_largest = 0;
+    pose_state *st = limb_state(rig, 1);
+    assert_true(g_largest < work);
+    assert_int_equal(pose_apply(st), POSE_OK);
+    assert_true(g_largest < work);
+
+    g_fail_above = work;
+    assert_int_equal(pose_set_method(st, POSE_FEM), POSE_ERR_OUT_OF_MEMORY);
+    assert_non_null(strstr(pose_last_error(), "pose_set_method"));
+    assert_int_equal(pose_get_method(st), POSE_DQS);
+    assert_int_equal(pose_step(st, 1.0 / 120.0), POSE_ERR_OUT_OF_MEMORY);
+    assert_int_equal(pose_apply(st), POSE_OK);
+    pose_state_options so = {.size = sizeof so, .threads = 1, .method = POSE_FEM,
+                             .allocator = {count_alloc, count_free, NULL}};
+    pose_state *fem = (pose_state *)&so; /* must come back NULL */
+    assert_int_equal(pose_state_create_ex(rig, &so, &fem), POSE_ERR_OUT_OF_MEMORY);
+    assert_null(fem);
+    g_fail_above = 0;
+
+    assert_int_equal(pose_set_method(st, POSE_FEM), POSE_OK);
+    assert_true(g_largest >= work);
+    const size_t allocs = g_allocs;
+    bend(st, 30.0);
+    assert_int_equal(pose_apply(st), POSE_OK);
+    assert_int_equal(pose_step(st, 1.0 / 120.0), POSE_OK); /* the simulation's own buffers */
+    assert_true(g_allocs > allocs);
+    const size_t stepped = g_allocs;
+    assert_int_equal(pose_step(st, 1.0 / 120.0), POSE_OK);
+    assert_int_equal(g_allocs, stepped);
+    printf("a skinning state's largest allocation stays under the solver's %zu bytes; POSE_FEM "
+           "allocates them, and a failed allocation leaves the state as it was\n", work);
+    pose_state_free(st);
+    pose_rig_free(rig);
+    free_box(&b);
+}
+
 /* "threads" as the argument: only the test the TSan stage runs. */
 int main(int argc, char **argv)
 {
@@ -470,6 +525,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_swing_dt_30),
         cmocka_unit_test(test_threads_and_allocation),
         cmocka_unit_test(test_api_errors_and_reset),
+        cmocka_unit_test(test_fem_work_on_first_use),
     };
     const struct CMUnitTest threads[] = {
         cmocka_unit_test(test_threads_and_allocation),

@@ -555,7 +555,9 @@ POSE_API pose_status pose_set_root(pose_state *state, const float translation[3]
                                    const float quat_xyzw[4]);
 /** All joints back to rest, root transform to identity. @since 0.1 */
 POSE_API pose_status pose_reset(pose_state *state);
-/** Choose the skinning method; POSE_ERR_UNSUPPORTED for POSE_COR on a rig without CoR. @since 0.1 */
+/** Choose the skinning method; POSE_ERR_UNSUPPORTED for POSE_COR on a rig without CoR.
+ *  The first POSE_FEM allocates the solver's work arrays (POSE_FEM below);
+ *  POSE_ERR_OUT_OF_MEMORY then, the method unchanged. @since 0.1 */
 POSE_API pose_status pose_set_method(pose_state *state, pose_method method);
 /** The current skinning method. @since 0.1 */
 POSE_API pose_method pose_get_method(const pose_state *state);
@@ -610,6 +612,13 @@ POSE_API pose_status pose_joint_world(const pose_state *state, int joint, pose_t
  * result is identical for any thread count; it depends on the state's
  * previous poses only through where the rotations start (differences far
  * below the tolerance). pose_apply still allocates nothing.
+ *
+ * The solver's work arrays (60 floats a soft tet and a few per vertex: 406 MB
+ * on a default bake of the bundled body) are allocated, with the state's
+ * allocator, when the state first needs them: pose_state_create_ex with
+ * POSE_FEM, pose_set_method(POSE_FEM), or the dynamics' first
+ * pose_step / pose_set_dynamics_options / pose_reset_dynamics. A state that
+ * only skins never carries them.
  */
 
 /** The soft tissue's linear isotropic material (pose_rig_desc.fem). */
