@@ -226,9 +226,21 @@ static pose_status cluster_lists(cover_build *b)
     return POSE_OK;
 }
 
+/* Squared distance between a node's box and the box lo..hi. */
+static float box_gap2(const pose__bvh_node *n, const float *lo, const float *hi)
+{
+    float gap = 0.0f;
+    for (int d = 0; d < 3; d++) {
+        const float e = n->lo[d] > hi[d] ? n->lo[d] - hi[d] : lo[d] > n->hi[d] ? lo[d] - n->hi[d] : 0.0f;
+        gap += e * e;
+    }
+    return gap;
+}
+
 /* The least distance from the counted vertices of bone j (rest positions
  * `rest`) to triangle r, found up to `cap` (cap when none is nearer):
- * boxes against the triangle's box, then exact distances. */
+ * boxes against the triangle's box, the nearer child first (the least so
+ * far then prunes more of the other), then exact distances. */
 static float tri_clearance(const pose__bvh *t, const float *rest, const float *const r[3], float cap,
                            uint32_t *stack)
 {
@@ -238,25 +250,27 @@ static float tri_clearance(const pose__bvh *t, const float *rest, const float *c
         hi[d] = fmaxf(fmaxf(r[0][d], r[1][d]), r[2][d]);
     }
     int top = 0;
-    if (t->node_count)
+    if (t->node_count && box_gap2(&t->nodes[0], lo, hi) < best)
         stack[top++] = 0;
     while (top > 0) {
         const pose__bvh_node *n = &t->nodes[stack[--top]];
-        float gap = 0.0f;
-        for (int d = 0; d < 3; d++) {
-            const float e = n->lo[d] > hi[d] ? n->lo[d] - hi[d] : lo[d] > n->hi[d] ? lo[d] - n->hi[d] : 0.0f;
-            gap += e * e;
-        }
-        if (gap >= best)
+        if (box_gap2(n, lo, hi) >= best) /* best may have shrunk since it was pushed */
             continue;
         if (!n->count) {
-            stack[top++] = n->first;
-            stack[top++] = n->first + 1;
+            const float g0 = box_gap2(&t->nodes[n->first], lo, hi), g1 = box_gap2(&t->nodes[n->first + 1], lo, hi);
+            const uint32_t near = g0 <= g1 ? n->first : n->first + 1, far = g0 <= g1 ? n->first + 1 : n->first;
+            const float gn = g0 <= g1 ? g0 : g1, gf = g0 <= g1 ? g1 : g0;
+            if (gf < best)
+                stack[top++] = far;
+            if (gn < best)
+                stack[top++] = near;
             continue;
         }
-        for (uint32_t i = n->first; i < n->first + n->count; i++)
-            best = fminf(best, pose__point_tri_dist2(rest + 3 * (size_t)t->triangles[3 * (size_t)t->items[i]],
-                                                     r[0], r[1], r[2]));
+        for (uint32_t i = n->first; i < n->first + n->count; i++) {
+            const float d2 = pose__point_tri_dist2(rest + 3 * (size_t)t->triangles[3 * (size_t)t->items[i]], r[0],
+                                                   r[1], r[2]);
+            best = d2 < best ? d2 : best;
+        }
     }
     return sqrtf(best);
 }

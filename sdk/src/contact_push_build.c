@@ -133,9 +133,21 @@ float pose__push_distance(const pose__push_bone *b, const float *q, float max_di
     return side >= 0.0f ? d : -d;
 }
 
+static inline double min_d(double a, double b)
+{
+    return a < b ? a : b;
+}
+
+static inline double max_d(double a, double b)
+{
+    return a > b ? a : b;
+}
+
 /* Triangle abc overlaps the cube of centre c and half side h: no
  * separating axis among the cube's 3, the triangle's normal and the 9
- * edge x axis products (Akenine-Moller 2001), in double. */
+ * edge x axis products (Akenine-Moller 2001), in double. (min_d and max_d,
+ * not fmin and fmax: no NaN comes here, and libm's are calls, a fifth of
+ * the bones' grids' build.) */
 static int tri_box_overlap(const double *c, double h, const float *a, const float *b, const float *d)
 {
     double v[3][3], e[3][3];
@@ -145,7 +157,7 @@ static int tri_box_overlap(const double *c, double h, const float *a, const floa
         v[2][k] = (double)d[k] - c[k];
     }
     for (int k = 0; k < 3; k++) {
-        const double lo = fmin(fmin(v[0][k], v[1][k]), v[2][k]), hi = fmax(fmax(v[0][k], v[1][k]), v[2][k]);
+        const double lo = min_d(min_d(v[0][k], v[1][k]), v[2][k]), hi = max_d(max_d(v[0][k], v[1][k]), v[2][k]);
         if (lo > h || hi < -h)
             return 0;
     }
@@ -165,8 +177,8 @@ static int tri_box_overlap(const double *c, double h, const float *a, const floa
             double lo = INFINITY, hi = -INFINITY;
             for (int i = 0; i < 3; i++) {
                 const double p = m[0] * v[i][0] + m[1] * v[i][1] + m[2] * v[i][2];
-                lo = fmin(lo, p);
-                hi = fmax(hi, p);
+                lo = min_d(lo, p);
+                hi = max_d(hi, p);
             }
             const double r = h * (fabs(m[0]) + fabs(m[1]) + fabs(m[2]));
             if (lo > r || hi < -r)
