@@ -96,6 +96,11 @@ typedef struct pose__bvh_near {
 float pose__bvh_nearest(const pose__bvh *t, const float *positions, const float *p, float max_dist,
                         pose__bvh_near *out);
 
+/** Whether a triangle of t lies nearer to p than max_dist: exactly when
+ *  pose__bvh_nearest(t, positions, p, max_dist, ...) finds one, but it
+ *  stops at the first (nearer children first). rt_bvh_nearest.c. */
+int pose__bvh_any_within(const pose__bvh *t, const float *positions, const float *p, float max_dist);
+
 /** Squared distance from p to triangle abc. rt_bvh_nearest.c. */
 float pose__point_tri_dist2(const float *p, const float *a, const float *b, const float *c);
 

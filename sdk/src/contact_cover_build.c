@@ -88,8 +88,7 @@ static pose_status bone_points(cover_build *b, size_t j, const pose__tissue *ts)
     uint32_t n = 0;
     for (size_t v = 0; v < ts->vertex_count; v++) {
         const float *x = ts->positions + 3 * v;
-        pose__bvh_near near;
-        if (pose__bvh_nearest(&l->skin, l->skin_rest, x, depth, &near) > depth ||
+        if (!pose__bvh_any_within(&l->skin, l->skin_rest, x, depth) ||
             pose__bvh_winding(&l->skin, l->skin_rest, x) <= 0)
             continue;
         pts[3 * n] = pts[3 * n + 1] = pts[3 * n + 2] = (uint32_t)v;

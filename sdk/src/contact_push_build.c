@@ -216,6 +216,13 @@ static pose_status bone_gap(pose__push_bone *b, const uint8_t *cells, uint32_t *
         if (cells[i] != POSE__CELL_OUT)
             queue[tail++] = (uint32_t)i;
     }
+    ptrdiff_t step[26]; /* the 26 neighbours' index offsets */
+    int steps = 0;
+    for (int dz = -1; dz <= 1; dz++)
+        for (int dy = -1; dy <= 1; dy++)
+            for (int dx = -1; dx <= 1; dx++)
+                if (dx || dy || dz)
+                    step[steps++] = (ptrdiff_t)dz * (ptrdiff_t)sz + (ptrdiff_t)dy * (ptrdiff_t)sy + dx;
     while (head < tail) {
         const size_t i = queue[head++];
         const int x = (int)(i % sy), y = (int)((i / sy) % (size_t)b->dim[1]), z = (int)(i / sz);
@@ -224,6 +231,18 @@ static pose_status bone_gap(pose__push_bone *b, const uint8_t *cells, uint32_t *
         const int next = code[i] < POSE__CELL_OUT ? POSE__CELL_OUT : code[i] + 1;
         if (next >= 255)
             continue;
+        if (x > 0 && y > 0 && z > 0 && x < b->dim[0] - 1 && y < b->dim[1] - 1 && z < b->dim[2] - 1) {
+            /* inside the grid: every neighbour exists (most cells; the same
+             * neighbours in the same order as the border's loop below) */
+            for (int k = 0; k < 26; k++) {
+                const size_t j = (size_t)((ptrdiff_t)i + step[k]);
+                if (code[j] > next) {
+                    code[j] = (uint8_t)next;
+                    queue[tail++] = (uint32_t)j;
+                }
+            }
+            continue;
+        }
         for (int dz = -1; dz <= 1; dz++)
             for (int dy = -1; dy <= 1; dy++)
                 for (int dx = -1; dx <= 1; dx++) {
@@ -319,12 +338,20 @@ static pose_status bone_grid(pose__push_bone *b, const pose__tissue *ts, float m
         const float *x0 = ts->positions + 3 * (size_t)t[0], *x1 = ts->positions + 3 * (size_t)t[1],
                     *x2 = ts->positions + 3 * (size_t)t[2];
         const double hs = 0.5 * (double)b->cell + 1e-3 * (double)b->cell, h = hs + (double)margin;
+        double tlo[3], thi[3]; /* the triangle's box: tri_box_overlap's first test, before its call */
+        for (int d = 0; d < 3; d++) {
+            tlo[d] = min_d(min_d(x0[d], x1[d]), x2[d]);
+            thi[d] = max_d(max_d(x0[d], x1[d]), x2[d]);
+        }
         for (int z = c0[2]; z <= c1[2]; z++)
             for (int y = c0[1]; y <= c1[1]; y++)
                 for (int x = c0[0]; x <= c1[0]; x++) {
                     const size_t i = (size_t)z * sz + (size_t)y * sy + (size_t)x * sx;
                     const double c[3] = {b->lo[0] + (x + 0.5) * (double)b->cell, b->lo[1] + (y + 0.5) * (double)b->cell,
                                          b->lo[2] + (z + 0.5) * (double)b->cell};
+                    if (tlo[0] - c[0] > h || thi[0] - c[0] < -h || tlo[1] - c[1] > h || thi[1] - c[1] < -h ||
+                        tlo[2] - c[2] > h || thi[2] - c[2] < -h)
+                        continue;
                     if (!(state[i] & SURF) && tri_box_overlap(c, h, x0, x1, x2))
                         state[i] |= NEAR | (tri_box_overlap(c, hs, x0, x1, x2) ? SURF : 0);
                 }
