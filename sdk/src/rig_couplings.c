@@ -122,6 +122,9 @@ pose_status pose_rig_fem_nodes_near_joint(const pose_rig *rig, int joint, float 
     if (!pose_rig_has_fem(rig))
         return pose__fail(POSE_ERR_UNSUPPORTED,
                           "pose_rig_fem_nodes_near_joint: the rig has no fem section");
+    pose_status s = pose__rig_fem_mesh(rig, "pose_rig_fem_nodes_near_joint");
+    if (s < 0)
+        return s;
     const pose__fem_mesh *m = &rig->rt->fem;
     const double r2 = (double)reach * reach;
     int bones = 0;

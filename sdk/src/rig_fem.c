@@ -34,7 +34,7 @@ pose_status pose__fem_validate(const pose_rig *rig, const pose__source *src)
 
 int pose_rig_has_fem(const pose_rig *rig)
 {
-    return rig && rig->fem && rig->rt && rig->rt->fem_block;
+    return rig && rig->fem && rig->rt && rig->rt->fem_size; /* the mesh itself is built on first use */
 }
 
 pose_status pose_rig_fem_material(const pose_rig *rig, pose_fem_material *out)

@@ -173,6 +173,10 @@ static inline const pose__clinical_record *pose__joint_clinical(const pose_rig *
  * by the caller; pose__set_error has been called.
  */
 pose_status pose__rig_prepare(pose_rig *rig);
+/** POSE_FEM's simulation mesh (rig->rt->fem), built by the first call
+ *  (under the rig's lock: any thread); POSE_ERR_UNSUPPORTED without a fem
+ *  section, POSE_ERR_OUT_OF_MEMORY naming `fn`. */
+pose_status pose__rig_fem_mesh(const pose_rig *rig, const char *fn);
 /** Release what pose__rig_prepare built; tolerates rig->rt == NULL. */
 void pose__rig_release(pose_rig *rig);
 

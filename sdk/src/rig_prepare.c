@@ -151,36 +151,54 @@ static void build_fans(const pose_rig *rig, const size_t *tissue_offset, uint32_
 
 /* The simulation mesh of POSE_FEM is the rig's own tet mesh: bone tets are
  * rigid (their vertices held), soft tets take the fem section's material.
- * Its vertices are the skinned ones, so nothing needs embedding. */
+ * Its vertices are the skinned ones, so nothing needs embedding. At load
+ * only its size is counted (and checked); pose__rig_fem_mesh builds it. */
 static pose_status prepare_fem(pose_rig *rig)
 {
     if (!rig->fem)
         return POSE_OK;
-    size_t size = pose__fem_mesh_size(rig->tet_vertex_count, rig->tet_count, rig->tets,
-                                      rig->tet_labels);
-    if (size == 0)
+    rig->rt->fem_size = pose__fem_mesh_size(rig->tet_vertex_count, rig->tet_count, rig->tets, rig->tet_labels);
+    if (rig->rt->fem_size == 0)
         return pose__fail(POSE_ERR_UNSUPPORTED, "fem: tet mesh too large for 32-bit corner indices");
-    void *block = pose__alloc(&rig->allocator, size, POSE__ALIGN);
-    if (!block)
-        return pose__fail(POSE_ERR_OUT_OF_MEMORY,
-                          "out of memory for the simulation mesh (%zu bytes)", size);
-    pose__fem_material m = {rig->fem->young, rig->fem->poisson, rig->fem->density};
-    pose__fem_mesh_build(rig->tet_vertex_count, rig->tet_positions, rig->tet_count, rig->tets,
-                         rig->tet_labels, &m, block, &rig->rt->fem);
-    rig->rt->fem_block = block;
-    /* The body's volume is held through its closed skin (fem_mesh.h). */
-    for (size_t t = 0; t < rig->tissue_count; t++) {
-        const pose__tissue *ts = &rig->tissues[t];
-        if (ts->kind != POSE_TISSUE_SKIN || ts->triangle_count == 0)
-            continue;
-        pose__fem_surface s = {
-            .vertex_count = ts->vertex_count, .triangle_count = ts->triangle_count,
-            .tets = rig->tets, .tet = ts->tet, .bary = ts->bary, .triangles = ts->triangles,
-        };
-        pose__fem_mesh_set_surface(&rig->rt->fem, &s, rig->tet_positions);
-        break;
-    }
+    if (pose__mutex_init(&rig->rt->fem_lock) != 0)
+        return pose__fail(POSE_ERR_THREAD, "fem: could not create the simulation mesh's lock");
+    rig->rt->fem_lock_ready = 1;
     return POSE_OK;
+}
+
+pose_status pose__rig_fem_mesh(const pose_rig *rig, const char *fn)
+{
+    struct pose__rig_runtime *rt = rig->rt;
+    if (!rig->fem || !rt->fem_size)
+        return pose__fail(POSE_ERR_UNSUPPORTED, "%s: the rig has no fem section", fn);
+    pose_status s = POSE_OK;
+    pose__mutex_lock(&rt->fem_lock);
+    if (!rt->fem_block) {
+        void *block = pose__alloc(&rig->allocator, rt->fem_size, POSE__ALIGN);
+        if (!block) {
+            s = pose__fail(POSE_ERR_OUT_OF_MEMORY, "%s: out of memory for the simulation mesh (%zu bytes)", fn,
+                           rt->fem_size);
+        } else {
+            const pose__fem_material m = {rig->fem->young, rig->fem->poisson, rig->fem->density};
+            pose__fem_mesh_build(rig->tet_vertex_count, rig->tet_positions, rig->tet_count, rig->tets,
+                                 rig->tet_labels, &m, block, &rt->fem);
+            /* The body's volume is held through its closed skin (fem_mesh.h). */
+            for (size_t t = 0; t < rig->tissue_count; t++) {
+                const pose__tissue *ts = &rig->tissues[t];
+                if (ts->kind != POSE_TISSUE_SKIN || ts->triangle_count == 0)
+                    continue;
+                pose__fem_surface sf = {
+                    .vertex_count = ts->vertex_count, .triangle_count = ts->triangle_count,
+                    .tets = rig->tets, .tet = ts->tet, .bary = ts->bary, .triangles = ts->triangles,
+                };
+                pose__fem_mesh_set_surface(&rt->fem, &sf, rig->tet_positions);
+                break;
+            }
+            rt->fem_block = block; /* last: the mesh is whole once this is set */
+        }
+    }
+    pose__mutex_unlock(&rt->fem_lock);
+    return s;
 }
 
 pose_status pose__rig_prepare(pose_rig *rig)
@@ -327,6 +345,8 @@ void pose__rig_release(pose_rig *rig)
         pose__rig_release_outside(rig);
     if (rig->rt && rig->rt->fem_block)
         pose__free(&rig->allocator, rig->rt->fem_block);
+    if (rig->rt && rig->rt->fem_lock_ready)
+        pose__mutex_destroy(&rig->rt->fem_lock);
     if (rig->rt)
         pose__free(&rig->allocator, rig->rt->block);
     rig->rt = NULL;

@@ -10,6 +10,7 @@
 #include "rt_bind.h"
 #include "rt_quat.h"
 #include "rt_skin.h"
+#include "rt_thread.h"
 #include "rt_transfer.h"
 
 struct pose__rig_runtime {
@@ -29,9 +30,15 @@ struct pose__rig_runtime {
     pose__xform *rest_model; /**< joint frames at rest, as runtime transforms */
     void *block;             /**< the one allocation holding all of the above */
     /** POSE_FEM's simulation mesh (rigs with a fem section): the rig's own
-     *  tets, in its own allocation (fem_block, NULL without one). */
+     *  tets, in its own allocation (fem_block), built when a state first
+     *  needs it (pose__rig_fem_mesh: 64 bytes a soft tet, about 125 MB on
+     *  the default bake, which a rig that is only skinned should not carry).
+     *  fem_size: its bytes, counted at load (0: no fem section). */
     pose__fem_mesh fem;
     void *fem_block;
+    size_t fem_size;
+    pose__mutex fem_lock; /**< guards the build (states of one rig may be on any threads) */
+    int fem_lock_ready;
     /** Tissue vertices outside the tet mesh (rig_outside.c), bound to the
      *  mesh (rt_bind.h) and placed after the transfer: outside_index holds
      *  their numbers among all tissue vertices, ascending. Two allocations

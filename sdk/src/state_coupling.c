@@ -47,6 +47,9 @@ static size_t align64(size_t n)
 static pose_status build(pose_state *st, const void *src, size_t n, size_t stride, cpl_get get,
                          const char *fn)
 {
+    pose_status built = n ? pose__rig_fem_mesh(st->rig, fn) : POSE_OK; /* which nodes it holds */
+    if (built < 0)
+        return built;
     const pose__fem_mesh *m = &st->rt->fem;
     const size_t nv = st->rig->tet_vertex_count;
     size_t live = 0;

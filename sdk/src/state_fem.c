@@ -87,6 +87,9 @@ pose_status pose__state_fem_work(pose_state *st, const char *fn)
 {
     if (st->fem_block)
         return POSE_OK;
+    pose_status s = pose__rig_fem_mesh(st->rig, fn); /* the rig's simulation mesh (rig_prepare.c) */
+    if (s < 0)
+        return s;
     const size_t size = pose__fem_work_size(&st->rt->fem);
     st->fem_block = pose__alloc(&st->allocator, size, POSE__ALIGN);
     if (!st->fem_block)

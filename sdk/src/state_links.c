@@ -39,6 +39,9 @@ static const pose__soft_coupling_record *entry(const void *src, size_t i, size_t
  * apart (the previous ones freed only once the new block exists). */
 static pose_status build(pose_state *st, const void *src, size_t n, size_t stride, const char *fn)
 {
+    pose_status built = n ? pose__rig_fem_mesh(st->rig, fn) : POSE_OK; /* which nodes it holds */
+    if (built < 0)
+        return built;
     const pose__fem_mesh *m = &st->rt->fem;
     const size_t nv = st->rig->tet_vertex_count;
     size_t live = 0;

@@ -4,8 +4,8 @@
  * bones joined by soft tissue) settles after a step change of its joint,
  * stays stable under a 360 deg/s swing at dt 1/1000 and 1/30 s, gives the
  * same bits on 1 and 2 threads and allocates nothing per step; the API
- * refuses what it cannot do; the solver's work arrays are allocated on
- * first use. */
+ * refuses what it cannot do; the solver's work arrays and the rig's
+ * simulation mesh are allocated on first use. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -20,7 +20,8 @@
 #include "fem_box.h"
 #include "fem_dynamics.h"
 #include "pose/pose.h"
-#include "rt_skin.h" /* pose__kernels_force_generic, pose__kernels_variant */
+#include "rt_skin.h"   /* pose__kernels_force_generic, pose__kernels_variant */
+#include "rt_thread.h" /* pose__thread_start */
 
 typedef struct dyn_sim {
     sim s;
@@ -162,13 +163,21 @@ static void test_free_body_momentum(void **state)
 #define LIMB_D 0.015f
 
 static size_t g_allocs, g_largest, g_fail_above; /* g_fail_above 0: never fail */
+static size_t g_big, g_big_count; /* allocations of at least g_big bytes (0: none counted) */
+static pose__mutex g_count_lock;  /* states on two threads allocate at once (main) */
 static void *count_alloc(size_t size, size_t align, void *user)
 {
     (void)user;
-    if (g_fail_above && size > g_fail_above)
+    pose__mutex_lock(&g_count_lock);
+    const int fail = g_fail_above && size > g_fail_above;
+    if (!fail) {
+        g_allocs++;
+        g_largest = size > g_largest ? size : g_largest;
+        g_big_count += g_big && size >= g_big;
+    }
+    pose__mutex_unlock(&g_count_lock);
+    if (fail)
         return NULL;
-    g_allocs++;
-    g_largest = size > g_largest ? size : g_largest;
     void *p = NULL;
     return posix_memalign(&p, align < sizeof(void *) ? sizeof(void *) : align, size) ? NULL : p;
 }
@@ -178,7 +187,7 @@ static void count_free(void *p, void *user)
     free(p);
 }
 
-static pose_rig *limb_rig(box *b, float density)
+static pose_rig *limb_rig_with(box *b, float density, const pose_allocator *allocator)
 {
     *b = make_box(LIMB_NX, LIMB_N, LIMB_N, LIMB_D, 2);
     const float mid = 0.5f * LIMB_NX * LIMB_D, c = 0.5f * LIMB_N * LIMB_D;
@@ -208,12 +217,17 @@ static pose_rig *limb_rig(box *b, float density)
                        .tet_labels = b->labels, .influences = 1, .weight_joints = wj,
                        .weights = w, .fem = &fem};
     pose_rig *rig = NULL;
-    pose_status st = pose_rig_create(&d, NULL, &rig);
+    pose_status st = pose_rig_create(&d, allocator, &rig);
     free(wj);
     free(w);
     if (st != POSE_OK)
         fprintf(stderr, "limb rig: %s\n", pose_last_error());
     return rig;
+}
+
+static pose_rig *limb_rig(box *b, float density)
+{
+    return limb_rig_with(b, density, NULL);
 }
 
 static pose_state *limb_state(const pose_rig *rig, int threads)
@@ -515,6 +529,64 @@ static void test_fem_work_on_first_use(void **state)
     free_box(&b);
 }
 
+/* The rig's simulation mesh (64 bytes a soft tet) is built when a state
+ * first needs it, once, whichever threads ask at the same time; a rig that
+ * is only skinned never carries it (about 125 MB on the default bake). */
+static void *fem_on_thread(void *arg)
+{
+    pose_state *st = arg;
+    return pose_set_method(st, POSE_FEM) == POSE_OK ? st : NULL;
+}
+
+static void test_fem_mesh_on_first_use(void **state)
+{
+    (void)state;
+    box b;
+    g_largest = 0;
+    g_big_count = 0;
+    const pose_allocator counting = {count_alloc, count_free, NULL};
+    pose_rig *rig = limb_rig_with(&b, 1000.0f, &counting);
+    assert_non_null(rig);
+    size_t soft = 0;
+    for (size_t t = 0; t < b.nt; t++)
+        soft += b.labels[t] == 0;
+    const size_t mesh = 64 * soft; /* at least its per-tet records */
+    assert_true(pose_rig_has_fem(rig));
+    assert_true(g_largest < mesh);
+    pose_state *a = limb_state(rig, 1), *c = limb_state(rig, 1);
+    assert_int_equal(pose_apply(a), POSE_OK);
+    assert_true(g_largest < mesh);
+
+    g_fail_above = mesh - 1; /* the rig's allocator too: the mesh cannot be built */
+    assert_int_equal(pose_set_method(a, POSE_FEM), POSE_ERR_OUT_OF_MEMORY);
+    assert_non_null(strstr(pose_last_error(), "simulation mesh"));
+    assert_int_equal(pose_get_method(a), POSE_DQS);
+    g_fail_above = 0;
+
+    g_big = mesh;
+    pose__thread t1, t2;
+    assert_int_equal(pose__thread_start(&t1, fem_on_thread, a), 0);
+    assert_int_equal(pose__thread_start(&t2, fem_on_thread, c), 0);
+    pose__thread_join(&t1);
+    pose__thread_join(&t2);
+    g_big = 0;
+    assert_int_equal(pose_get_method(a), POSE_FEM);
+    assert_int_equal(pose_get_method(c), POSE_FEM);
+    bend(a, 30.0);
+    bend(c, 30.0);
+    assert_int_equal(pose_apply(a), POSE_OK);
+    assert_int_equal(pose_apply(c), POSE_OK);
+    assert_memory_equal(pose_tet_positions(a, NULL), pose_tet_positions(c, NULL), 3 * b.nv * sizeof(float));
+    /* one mesh for the rig, one work block per state */
+    printf("%zu allocations of %zu bytes or more for two states set to POSE_FEM at once (the rig's mesh once, "
+           "each state's work)\n", g_big_count, mesh);
+    assert_int_equal(g_big_count, 3);
+    pose_state_free(a);
+    pose_state_free(c);
+    pose_rig_free(rig);
+    free_box(&b);
+}
+
 /* "threads" as the argument: only the test the TSan stage runs. */
 int main(int argc, char **argv)
 {
@@ -526,10 +598,14 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_threads_and_allocation),
         cmocka_unit_test(test_api_errors_and_reset),
         cmocka_unit_test(test_fem_work_on_first_use),
+        cmocka_unit_test(test_fem_mesh_on_first_use),
     };
     const struct CMUnitTest threads[] = {
         cmocka_unit_test(test_threads_and_allocation),
+        cmocka_unit_test(test_fem_mesh_on_first_use),
     };
+    if (pose__mutex_init(&g_count_lock) != 0)
+        return 1;
     if (argc > 1 && !strcmp(argv[1], "threads"))
         return cmocka_run_group_tests(threads, NULL, NULL);
     return cmocka_run_group_tests(all, NULL, NULL);

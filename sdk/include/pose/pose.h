@@ -617,8 +617,12 @@ POSE_API pose_status pose_joint_world(const pose_state *state, int joint, pose_t
  * on a default bake of the bundled body) are allocated, with the state's
  * allocator, when the state first needs them: pose_state_create_ex with
  * POSE_FEM, pose_set_method(POSE_FEM), or the dynamics' first
- * pose_step / pose_set_dynamics_options / pose_reset_dynamics. A state that
- * only skins never carries them.
+ * pose_step / pose_set_dynamics_options / pose_reset_dynamics. The rig's
+ * simulation mesh (64 bytes a soft tet: about 125 MB there) is built, with
+ * the rig's allocator, at the first of these on any of its states (or by
+ * couplings and pose_rig_fem_nodes_near_joint), once, whatever the threads.
+ * A rig and states that only skin never carry either; POSE_ERR_OUT_OF_MEMORY
+ * at those calls leaves the state as it was.
  */
 
 /** The soft tissue's linear isotropic material (pose_rig_desc.fem). */
