@@ -274,40 +274,45 @@ static float tri_clearance(const pose__bvh *t, const float *rest, const float *c
     return sqrtf(best);
 }
 
-/* Per pair and per triangle of its cluster, the distance at rest between
- * the triangle and the bone's counted vertices: skin must move by more,
- * relative to the bone, to cross one of them. */
+/* Cluster c's pairs: per pair and per triangle of the cluster, the distance
+ * at rest between the triangle and the bone's counted vertices (skin must
+ * move by more, relative to the bone, to cross one of them). An item of the
+ * state's pool: it writes its own pairs' entries only. */
+static void clearance_item(void *ctx, size_t c)
+{
+    const cover_build *b = ctx;
+    pose__cover *l = b->l;
+    uint32_t stack[2 * POSE__BVH_MAX_DEPTH + 2];
+    for (uint32_t k = l->pair_begin[c]; k < l->pair_begin[c + 1]; k++) {
+        const uint32_t j = l->pair_bone[k];
+        const float *rest = b->st->rig->tissues[b->tissue[j]].positions;
+        float least = INFINITY;
+        for (size_t i = 0; i < POSE__COVER_CLUSTER; i++) {
+            const size_t f = c * POSE__COVER_CLUSTER + i;
+            float clear = INFINITY;
+            if (f < l->tri_count) {
+                const uint32_t *v = l->tris + 3 * f;
+                const float *r[3] = {l->skin_rest + 3 * (size_t)v[0], l->skin_rest + 3 * (size_t)v[1],
+                                     l->skin_rest + 3 * (size_t)v[2]};
+                clear = tri_clearance(&l->trees[j], rest, r, 2.0f * POSE__COVER_DEPTH, stack);
+            }
+            l->tri_clear[(size_t)k * POSE__COVER_CLUSTER + i] = clear;
+            least = fminf(least, clear);
+        }
+        l->pair_clear[k] = least;
+    }
+}
+
+/* Every pair's clearances, clusters shared out among the state's threads. */
 static pose_status clearances(cover_build *b)
 {
     pose__cover *l = b->l;
     const size_t np = l->pair_begin[l->cluster_count];
     l->pair_clear = pose__alloc(b->a, (np + 1) * sizeof(float), POSE__ALIGN);
     l->tri_clear = pose__alloc(b->a, (np * POSE__COVER_CLUSTER + 1) * sizeof(float), POSE__ALIGN);
-    uint32_t *stack = pose__alloc(b->a, (2 * POSE__BVH_MAX_DEPTH + 2) * sizeof *stack, POSE__ALIGN);
-    if (!l->pair_clear || !l->tri_clear || !stack) {
-        pose__free(b->a, stack);
+    if (!l->pair_clear || !l->tri_clear)
         return oom("clearances");
-    }
-    for (size_t c = 0; c < l->cluster_count; c++)
-        for (uint32_t k = l->pair_begin[c]; k < l->pair_begin[c + 1]; k++) {
-            const uint32_t j = l->pair_bone[k];
-            const float *rest = b->st->rig->tissues[b->tissue[j]].positions;
-            float least = INFINITY;
-            for (size_t i = 0; i < POSE__COVER_CLUSTER; i++) {
-                const size_t f = c * POSE__COVER_CLUSTER + i;
-                float clear = INFINITY;
-                if (f < l->tri_count) {
-                    const uint32_t *v = l->tris + 3 * f;
-                    const float *r[3] = {l->skin_rest + 3 * (size_t)v[0], l->skin_rest + 3 * (size_t)v[1],
-                                         l->skin_rest + 3 * (size_t)v[2]};
-                    clear = tri_clearance(&l->trees[j], rest, r, 2.0f * POSE__COVER_DEPTH, stack);
-                }
-                l->tri_clear[(size_t)k * POSE__COVER_CLUSTER + i] = clear;
-                least = fminf(least, clear);
-            }
-            l->pair_clear[k] = least;
-        }
-    pose__free(b->a, stack);
+    pose__pool_run_items(b->st->pool, clearance_item, b, l->cluster_count);
     return POSE_OK;
 }
 

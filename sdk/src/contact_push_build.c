@@ -194,22 +194,11 @@ static int tri_box_overlap(const double *c, double h, const float *a, const floa
  * non-OUT cell, so a cluster of skin whose sphere is smaller than that has
  * no vertex to test. Stored in bricks of 4 x 4 x 4 cells (one cache line):
  * a cluster's vertices read a few lines instead of a line per row. */
-static pose_status bone_gap(pose__push_bone *b, const uint8_t *cells, uint32_t *queue, const pose_allocator *a)
+static void bone_gap(pose__push_bone *b, const uint8_t *cells, uint32_t *queue, uint8_t *code)
 {
     const size_t sy = (size_t)b->dim[0], sz = (size_t)b->dim[0] * (size_t)b->dim[1];
     const size_t cells_n = sz * (size_t)b->dim[2];
-    uint8_t *code = pose__alloc(a, cells_n, POSE__ALIGN);
-    size_t bricks = 1;
-    for (int d = 0; d < 3; d++) {
-        b->bricks[d] = (b->dim[d] + 3) / 4;
-        bricks *= (size_t)b->bricks[d];
-    }
-    b->grid = pose__alloc(a, 64 * bricks, POSE__ALIGN);
-    b->brick_gap = pose__alloc(a, bricks, POSE__ALIGN);
-    if (!code || !b->grid || !b->brick_gap) {
-        pose__free(a, code);
-        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for a bone grid of %zu cells", cells_n);
-    }
+    const size_t bricks = (size_t)b->bricks[0] * (size_t)b->bricks[1] * (size_t)b->bricks[2];
     size_t head = 0, tail = 0;
     for (size_t i = 0; i < cells_n; i++) {
         code[i] = cells[i] == POSE__CELL_OUT ? 255 : cells[i];
@@ -271,8 +260,6 @@ static pose_status bone_gap(pose__push_bone *b, const uint8_t *cells, uint32_t *
             least = b->grid[64 * k + c] < least ? b->grid[64 * k + c] : least;
         b->brick_gap[k] = least >= POSE__CELL_OUT ? (uint8_t)(least - (POSE__CELL_OUT - 1)) : 0;
     }
-    pose__free(a, code);
-    return POSE_OK;
 }
 
 /* The bone's sphere and grid (contact_push.h's cell states): cells a
@@ -284,7 +271,7 @@ static pose_status bone_gap(pose__push_bone *b, const uint8_t *cells, uint32_t *
  * all outside. (Where a bone's mesh is open the fill leaks in and its
  * inside reads outside: such points are not pushed.) Then the gap to the
  * non-OUT cells. */
-static pose_status bone_grid(pose__push_bone *b, const pose__tissue *ts, float margin, const pose_allocator *a)
+static size_t bone_grid_size(pose__push_bone *b, const pose__tissue *ts, float margin)
 {
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t v = 0; v < ts->vertex_count; v++)
@@ -313,14 +300,21 @@ static pose_status bone_grid(pose__push_bone *b, const pose__tissue *ts, float m
         cells *= (size_t)b->dim[d];
     }
     b->inv_cell = 1.0f / b->cell;
+    for (int d = 0; d < 3; d++)
+        b->bricks[d] = (b->dim[d] + 3) / 4;
+    return cells;
+}
+
+/* Fill bone b's grid (sized and allocated by the build) from its triangles,
+ * with `state`, `queue` and `code` as scratch of at least its cell count
+ * (bytes, 32-bit entries, bytes): no allocation, so bones are filled on the
+ * state's threads. */
+static void bone_grid_fill(pose__push_bone *b, const pose__tissue *ts, float margin, uint8_t *state, uint32_t *queue,
+                           uint8_t *code)
+{
+    const size_t cells = (size_t)b->dim[0] * (size_t)b->dim[1] * (size_t)b->dim[2];
     enum { NEAR = 1, SURF = 2, SEEN = 4 }; /* build bits */
-    uint8_t *state = pose__calloc(a, cells, POSE__ALIGN);
-    uint32_t *queue = pose__alloc(a, cells * sizeof *queue, POSE__ALIGN);
-    if (!state || !queue) {
-        pose__free(a, state);
-        pose__free(a, queue);
-        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for a bone grid of %zu cells", cells);
-    }
+    memset(state, 0, cells);
     const size_t sx = 1, sy = (size_t)b->dim[0], sz = (size_t)b->dim[0] * (size_t)b->dim[1];
     for (size_t f = 0; f < ts->triangle_count; f++) {
         int c0[3], c1[3];
@@ -391,10 +385,7 @@ static pose_status bone_grid(pose__push_bone *b, const pose__tissue *ts, float m
         state[i] = state[i] & SURF   ? POSE__CELL_SURF
                    : state[i] & NEAR ? (state[i] & SEEN ? POSE__CELL_NEAR_OUT : POSE__CELL_NEAR_IN)
                                      : (state[i] & SEEN ? POSE__CELL_OUT : POSE__CELL_IN);
-    const pose_status r = bone_gap(b, state, queue, a);
-    pose__free(a, state);
-    pose__free(a, queue);
-    return r;
+    bone_gap(b, state, queue, code);
 }
 
 /* Skin vertices in Morton order of their rest positions: consecutive runs
@@ -639,6 +630,56 @@ void pose__push_release(pose__push *p)
     p->allocator = keep;
 }
 
+/* The bones' grids: sized and allocated one bone after another (the
+ * allocator is not promised to be thread-safe), then filled on the state's
+ * threads, bone k by part k mod parts, each part with its own scratch. */
+typedef struct grid_build {
+    pose__push *p;
+    float margin;
+    const pose__tissue **tissue; /* per bone */
+    size_t most;                 /* cells of the largest grid */
+    uint8_t *scratch;            /* per part: queue (4 most bytes), state (most), code (most) */
+} grid_build;
+
+static pose_status grid_alloc(pose__push_bone *b, const pose__tissue *ts, float margin, const pose_allocator *a,
+                              size_t *most)
+{
+    const size_t cells = bone_grid_size(b, ts, margin);
+    const size_t bricks = (size_t)b->bricks[0] * (size_t)b->bricks[1] * (size_t)b->bricks[2];
+    b->grid = pose__alloc(a, 64 * bricks, POSE__ALIGN);
+    b->brick_gap = pose__alloc(a, bricks, POSE__ALIGN);
+    if (!b->grid || !b->brick_gap)
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for a bone grid of %zu cells", cells);
+    *most = cells > *most ? cells : *most;
+    return POSE_OK;
+}
+
+static size_t grid_scratch_bytes(size_t most)
+{
+    return (6 * most + 63) & ~(size_t)63;
+}
+
+static void grid_task(void *ctx, unsigned part, unsigned parts)
+{
+    grid_build *g = ctx;
+    uint8_t *base = g->scratch + part * grid_scratch_bytes(g->most); /* 64-byte aligned */
+    uint32_t *queue = (uint32_t *)(void *)base;
+    uint8_t *state = base + 4 * g->most, *code = state + g->most;
+    for (size_t k = part; k < g->p->bone_count; k += parts)
+        bone_grid_fill(&g->p->bones[k], g->tissue[k], g->margin, state, queue, code);
+}
+
+static pose_status grids_fill(grid_build *g, pose__pool *pool)
+{
+    const unsigned parts = pose__pool_threads(pool);
+    g->scratch = pose__alloc(&g->p->allocator, parts * grid_scratch_bytes(g->most) + 64, POSE__ALIGN);
+    if (!g->scratch)
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for building the bones' grids (%zu cells)", g->most);
+    pose__pool_run(pool, grid_task, g);
+    pose__free(&g->p->allocator, g->scratch);
+    return POSE_OK;
+}
+
 pose_status pose__push_build(pose__push *p, const pose_state *st, float margin)
 {
     const double t0 = pose__seconds();
@@ -661,10 +702,15 @@ pose_status pose__push_build(pose__push *p, const pose_state *st, float margin)
     for (size_t j = 0; j < 4 * 64 * p->bone_words; j++) /* the padding never near (x infinite) */
         p->bone_spheres[j] = j < 64 * p->bone_words ? INFINITY : 0.0f;
     pose_status s = POSE_OK;
+    grid_build g = {.p = p, .margin = margin};
+    g.tissue = pose__alloc(&p->allocator, (nb + 1) * sizeof *g.tissue, POSE__ALIGN);
+    if (!g.tissue)
+        return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu bones", nb);
     for (size_t t = 0; t < rig->tissue_count && s == POSE_OK; t++) {
         const pose__tissue *ts = &rig->tissues[t];
         if (ts->kind != POSE_TISSUE_BONE || ts->joint < 0 || ts->triangle_count == 0)
             continue;
+        g.tissue[p->bone_count] = ts;
         pose__push_bone *b = &p->bones[p->bone_count++];
         b->joint = ts->joint;
         b->rest = ts->positions;
@@ -672,8 +718,11 @@ pose_status pose__push_build(pose__push *p, const pose_state *st, float margin)
         if (s == POSE_OK)
             s = pseudo_normals(b, ts, &p->allocator);
         if (s == POSE_OK)
-            s = bone_grid(b, ts, margin, &p->allocator);
+            s = grid_alloc(b, ts, margin, &p->allocator, &g.most);
     }
+    if (s == POSE_OK)
+        s = grids_fill(&g, st->pool);
+    pose__free(&p->allocator, g.tissue);
     if (s == POSE_OK)
         s = joint_spheres(p);
     if (s == POSE_OK)
