@@ -262,15 +262,8 @@ static void bone_gap(pose__push_bone *b, const uint8_t *cells, uint32_t *queue, 
     }
 }
 
-/* The bone's sphere and grid (contact_push.h's cell states): cells a
- * triangle crosses are SURF, the others that a triangle touches grown by
- * the margin NEAR_OUT or NEAR_IN, the rest OUT or IN, by a flood fill from
- * the grid's border (with a rounding allowance on each test). No point of
- * an OUT cell is inside or within the margin; every point of a SURF or NEAR
- * cell has a triangle within sqrt(3) (cell + margin); a NEAR_OUT cell is
- * all outside. (Where a bone's mesh is open the fill leaks in and its
- * inside reads outside: such points are not pushed.) Then the gap to the
- * non-OUT cells. */
+/* The bone's sphere, and its grid's box, spacing and bricks; returns the
+ * grid's cell count. */
 static size_t bone_grid_size(pose__push_bone *b, const pose__tissue *ts, float margin)
 {
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -305,10 +298,17 @@ static size_t bone_grid_size(pose__push_bone *b, const pose__tissue *ts, float m
     return cells;
 }
 
-/* Fill bone b's grid (sized and allocated by the build) from its triangles,
- * with `state`, `queue` and `code` as scratch of at least its cell count
- * (bytes, 32-bit entries, bytes): no allocation, so bones are filled on the
- * state's threads. */
+/* Fill bone b's grid (sized and allocated by the build; contact_push.h's
+ * cell states): cells a triangle crosses are SURF, the others that a
+ * triangle touches grown by the margin NEAR_OUT or NEAR_IN, the rest OUT or
+ * IN, by a flood fill from the grid's border (with a rounding allowance on
+ * each test). No point of an OUT cell is inside or within the margin; every
+ * point of a SURF or NEAR cell has a triangle within sqrt(3) (cell +
+ * margin); a NEAR_OUT cell is all outside. (Where a bone's mesh is open the
+ * fill leaks in and its inside reads outside: such points are not pushed.)
+ * Then the gap to the non-OUT cells. `state`, `queue` and `code` are
+ * scratch of at least its cell count (bytes, 32-bit entries, bytes): no
+ * allocation, so bones are filled on the state's threads. */
 static void bone_grid_fill(pose__push_bone *b, const pose__tissue *ts, float margin, uint8_t *state, uint32_t *queue,
                            uint8_t *code)
 {
