@@ -71,8 +71,10 @@ static float box_dist2(const pose__bvh_node *n, const float *p)
     return s;
 }
 
-float pose__bvh_nearest(const pose__bvh *t, const float *positions, const float *p, float max_dist,
-                        pose__bvh_near *out)
+/* The nearest triangle of t to p within max_dist, or with `first`, the
+ * first one found within it (nearer children first either way). */
+static float search(const pose__bvh *t, const float *positions, const float *p, float max_dist, int first,
+                    pose__bvh_near *out)
 {
     uint32_t stack[POSE__BVH_MAX_DEPTH + 2];
     int top = 0;
@@ -107,42 +109,22 @@ float pose__bvh_nearest(const pose__bvh *t, const float *positions, const float 
                 out->feature = feature;
                 for (int d = 0; d < 3; d++)
                     out->point[d] = q[d];
+                if (first)
+                    return sqrtf(best);
             }
         }
     }
     return out->triangle == UINT32_MAX ? INFINITY : sqrtf(best);
 }
 
+float pose__bvh_nearest(const pose__bvh *t, const float *positions, const float *p, float max_dist,
+                        pose__bvh_near *out)
+{
+    return search(t, positions, p, max_dist, 0, out);
+}
+
 int pose__bvh_any_within(const pose__bvh *t, const float *positions, const float *p, float max_dist)
 {
-    uint32_t stack[POSE__BVH_MAX_DEPTH + 2];
-    int top = 0;
-    const float reach = max_dist * max_dist; /* as pose__bvh_nearest's first bound */
-    if (!t->node_count)
-        return 0;
-    stack[top++] = 0;
-    while (top > 0) {
-        const pose__bvh_node *n = &t->nodes[stack[--top]];
-        if (box_dist2(n, p) >= reach)
-            continue;
-        if (!n->count) {
-            const uint32_t a = n->first, b = n->first + 1;
-            const int a_first = box_dist2(&t->nodes[a], p) <= box_dist2(&t->nodes[b], p);
-            stack[top++] = a_first ? b : a;
-            stack[top++] = a_first ? a : b;
-            continue;
-        }
-        for (uint32_t i = n->first; i < n->first + n->count; i++) {
-            const uint32_t *tri = t->triangles + 3 * (size_t)t->items[i];
-            float q[3];
-            int feature;
-            closest_on_tri(p, positions + 3 * (size_t)tri[0], positions + 3 * (size_t)tri[1],
-                           positions + 3 * (size_t)tri[2], q, &feature);
-            const float e2 = (q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) +
-                             (q[2] - p[2]) * (q[2] - p[2]);
-            if (e2 < reach)
-                return 1;
-        }
-    }
-    return 0;
+    pose__bvh_near near;
+    return search(t, positions, p, max_dist, 1, &near) != INFINITY;
 }
