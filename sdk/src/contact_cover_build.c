@@ -256,13 +256,13 @@ static float tri_clearance(const pose__bvh *t, const float *rest, const float *c
         if (box_gap2(n, lo, hi) >= best) /* best may have shrunk since it was pushed */
             continue;
         if (!n->count) {
-            const float g0 = box_gap2(&t->nodes[n->first], lo, hi), g1 = box_gap2(&t->nodes[n->first + 1], lo, hi);
-            const uint32_t near = g0 <= g1 ? n->first : n->first + 1, far = g0 <= g1 ? n->first + 1 : n->first;
-            const float gn = g0 <= g1 ? g0 : g1, gf = g0 <= g1 ? g1 : g0;
-            if (gf < best)
-                stack[top++] = far;
-            if (gn < best)
-                stack[top++] = near;
+            const uint32_t a = n->first, b = n->first + 1;
+            const float ga = box_gap2(&t->nodes[a], lo, hi), gb = box_gap2(&t->nodes[b], lo, hi);
+            const int a_first = ga <= gb; /* pushed last, popped first */
+            if ((a_first ? gb : ga) < best)
+                stack[top++] = a_first ? b : a;
+            if ((a_first ? ga : gb) < best)
+                stack[top++] = a_first ? a : b;
             continue;
         }
         for (uint32_t i = n->first; i < n->first + n->count; i++) {

@@ -671,8 +671,10 @@ static void grid_task(void *ctx, unsigned part, unsigned parts)
 
 static pose_status grids_fill(grid_build *g, pose__pool *pool)
 {
+    if (g->p->bone_count == 0)
+        return POSE_OK;
     const unsigned parts = pose__pool_threads(pool);
-    g->scratch = pose__alloc(&g->p->allocator, parts * grid_scratch_bytes(g->most) + 64, POSE__ALIGN);
+    g->scratch = pose__alloc(&g->p->allocator, parts * grid_scratch_bytes(g->most), POSE__ALIGN);
     if (!g->scratch)
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for building the bones' grids (%zu cells)", g->most);
     pose__pool_run(pool, grid_task, g);

@@ -53,8 +53,9 @@ size_t pose__state_transfer_soft(pose_state *st, size_t begin, size_t end, uint3
     return count;
 }
 
-/* count points and normals through (R, t): the matrix in locals and the
- * arrays restrict, so that no store makes the compiler reload them. */
+/* `count` points r and normals n through (R, t) into p and o: the matrix in
+ * locals and the arrays restrict, so that no store makes the compiler
+ * reload them. */
 static void place_rigid(const float *R, const float *t, const float *restrict r, const float *restrict n,
                         float *restrict p, float *restrict o, size_t count)
 {
