@@ -272,6 +272,9 @@ static void contact_item(void *ctx, size_t item)
                 bounds[k] = INFINITY;
         }
         const size_t groups = quiet ? 0 : pose__push_spheres(&y[0][0], NULL, 0, count, cluster, group);
+        pose__push_anchored anchored;
+        if (!quiet)
+            pose__push_anchors(p, p->node_anchor + vb, &y[0][0], NULL, NULL, count, &anchored);
         const uint32_t *near = p->near + item * p->bone_count;
         const size_t near_count = quiet ? 0 : pose__push_near_bones(p, item, cluster, NULL, bounds);
         for (size_t kb = 0; kb < near_count; kb++) {
@@ -279,10 +282,18 @@ static void contact_item(void *ctx, size_t item)
             const pose__push_bone *b = &p->bones[j];
             const float *f = p->frames + 12 * j;
             for (size_t g = 0; g < groups; g++) {
+                if (anchored.group_joint[g] == b->joint) {
+                    pose__quiet_bound(bounds, b->joint, anchored.group_clear[g]);
+                    continue;
+                }
                 if (!pose__push_group_near(p, j, group[g], bounds))
                     continue;
                 const size_t gb = g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < count ? gb + POSE__PUSH_GROUP : count;
                 for (size_t i = gb; i < ge; i++) {
+                    if (anchored.joint[i] == b->joint) {
+                        pose__quiet_bound(bounds, b->joint, anchored.clear[i]);
+                        continue;
+                    }
                     float sd, q[3], out[3], clear = 0.0f;
                     const int hit = nc[i].count < MAX_CONSTRAINTS &&
                                     pose__push_query(p, b, f, y[i], &p->node_cache[vb + i], &sd, q, out,

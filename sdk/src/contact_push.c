@@ -43,6 +43,11 @@ void pose__state_push_frames(pose_state *st)
     pose__quiet_joints_update(&p->quiet_joints, st->skin, p->joint_spheres);
 }
 
+/* Rounding room on an anchor's test (rig units: 1 micrometre on
+ * pose-bake's metres): the point's distance to the joint's bones is
+ * measured in their rest frame, through the frame's rounding. */
+#define ANCHOR_SLACK 1e-6f
+
 /* x (posed) into the bone's rest frame: R^T (x - t). */
 static void to_rest(const float *f, const float *x, float *q)
 {
@@ -211,6 +216,38 @@ static float push_vertex(const pose__push *p, const pose__push_bone *b, const fl
     }
     memcpy(x, y, sizeof y);
     return sqrtf(moved);
+}
+
+void pose__push_anchors(const pose__push *p, const pose__push_anchor *a, const float *pos, const uint32_t *idx,
+                        const uint8_t *skip, size_t count, pose__push_anchored *out)
+{
+    enum { GROUPS = POSE__PUSH_CLUSTER / POSE__PUSH_GROUP };
+    for (size_t g = 0; g < GROUPS; g++) {
+        out->group_joint[g] = -2; /* none yet: any joint */
+        out->group_clear[g] = INFINITY;
+    }
+    for (size_t i = 0; i < count; i++) {
+        const size_t g = i / POSE__PUSH_GROUP;
+        out->joint[i] = -1;
+        if (skip && skip[i])
+            continue;
+        const int32_t j = a[i].joint;
+        if (j >= 0) {
+            /* |q - rest| is how far the point strays from where the joint
+             * alone would carry it: its distance to the joint's bones is
+             * at least the rest distance less that */
+            float q[3];
+            to_rest(p->frames + 12 * (size_t)p->joint_bones[p->joint_start[j]], pos + 3 * (size_t)(idx ? idx[i] : i), q);
+            const float dx = q[0] - a[i].rest[0], dy = q[1] - a[i].rest[1], dz = q[2] - a[i].rest[2];
+            const float u = sqrtf(dx * dx + dy * dy + dz * dz);
+            if (u < a[i].room - ANCHOR_SLACK) {
+                out->joint[i] = j;
+                out->clear[i] = a[i].room + p->margin - u;
+                out->group_clear[g] = out->clear[i] < out->group_clear[g] ? out->clear[i] : out->group_clear[g];
+            }
+        }
+        out->group_joint[g] = out->group_joint[g] == -2 || out->group_joint[g] == out->joint[i] ? out->joint[i] : -1;
+    }
 }
 
 /* Box lo, hi grown to hold the points pos[3 idx[i]] (pos[3 i] when idx is
@@ -400,18 +437,28 @@ void pose__state_push_item(void *ctx, size_t item)
          * another stays there rather than move by more than its depth. (A
          * vertex not yet pushed has not moved: the spheres hold it.) */
         uint8_t done[POSE__PUSH_CLUSTER] = {0};
+        pose__push_anchored anchored;
+        pose__push_anchors(p, p->anchor + vb, st->tissue_positions, p->order + vb, p->skip + vb, ve - vb, &anchored);
         const uint32_t *near = p->near + item * p->bone_count;
         const size_t near_count = pose__push_near_bones(p, item, cluster, p->reach + c * p->bone_words, bounds);
         for (size_t k = 0; k < near_count; k++) {
             const pose__push_bone *b = &p->bones[near[k]];
             const float *f = p->frames + 12 * (size_t)near[k];
             for (size_t g = 0; g < groups; g++) {
+                if (anchored.group_joint[g] == b->joint) {
+                    pose__quiet_bound(bounds, b->joint, anchored.group_clear[g]);
+                    continue;
+                }
                 if (!pose__push_group_near(p, near[k], group[g], bounds))
                     continue;
                 const size_t gb = vb + g * POSE__PUSH_GROUP, ge = gb + POSE__PUSH_GROUP < ve ? gb + POSE__PUSH_GROUP : ve;
                 for (size_t i = gb; i < ge; i++) {
-                    if (p->skip[i] || done[i - vb] || p->own_joint[i] == b->joint)
+                    if (p->skip[i] || done[i - vb])
                         continue;
+                    if (anchored.joint[i - vb] == b->joint) {
+                        pose__quiet_bound(bounds, b->joint, anchored.clear[i - vb]);
+                        continue;
+                    }
                     float *x = st->tissue_positions + 3 * (size_t)p->order[i], before[3], clear = 0.0f;
                     memcpy(before, x, sizeof before);
                     float m = push_vertex(p, b, f, x, &p->cache[i], bounds ? &clear : NULL);

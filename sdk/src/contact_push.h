@@ -79,6 +79,31 @@ typedef struct pose__push_cache {
     } slot[2];
 } pose__push_cache;
 
+/** Where a point (skin vertex or node) lies at rest against the joint
+ *  that carries most of it (its largest skinning weight): as long as the
+ *  point strays from where that joint alone would carry it by less than
+ *  `room`, it is farther than the margin from every bone of that joint
+ *  (the distance is 1-Lipschitz), which then needs no search for it
+ *  (pose__push_anchors). Skin riding with a limb's bones, a hand's among
+ *  its 27, was most of what the passes searched. */
+typedef struct pose__push_anchor {
+    float rest[3];
+    float room;    /**< its rest distance to the joint's bones (counted up to POSE__PUSH_REACH)
+                        less the margin (> 0) */
+    int32_t joint; /**< -1: none (no bones, within the margin of one or inside one at rest) */
+} pose__push_anchor;
+
+/** A cluster's anchors tested against the pose (pose__push_anchors): per
+ *  point, the joint whose bones need no search for it, or -1, and a lower
+ *  bound on its distance to them; the same per group of
+ *  POSE__PUSH_GROUP, where every point of the group has that joint. */
+typedef struct pose__push_anchored {
+    int32_t joint[POSE__PUSH_CLUSTER];
+    float clear[POSE__PUSH_CLUSTER];
+    int32_t group_joint[POSE__PUSH_CLUSTER / POSE__PUSH_GROUP];
+    float group_clear[POSE__PUSH_CLUSTER / POSE__PUSH_GROUP];
+} pose__push_anchored;
+
 /** Most bones one node of the dynamic response touches at once. */
 #define POSE__PUSH_NODE_BONES 4
 
@@ -99,10 +124,7 @@ typedef struct pose__push {
     uint32_t *order;        /**< skin vertices (indices into all tissue vertices), cluster by cluster */
     uint8_t *skip;          /**< per entry of order: inside a bone at rest (anatomy: left alone) */
     pose__push_cache *cache; /**< per entry of order */
-    int32_t *own_joint;     /**< per entry of order: the joint whose bones it rides with rigidly
-                                 (embedded in a bone tet of that joint whose corners are all
-                                 weighted to it alone, at least RIGID_CLEARANCE from its bones
-                                 at rest): they are not searched for it; -1: none */
+    pose__push_anchor *anchor; /**< per entry of order (pose__push_anchors) */
     size_t vertex_count, cluster_count;
     uint64_t *reach;        /**< per cluster, a bit per bone (bone_words words): the bone
                                  lies within POSE__PUSH_REACH of the cluster at rest, so the
@@ -133,6 +155,7 @@ typedef struct pose__push {
                                  put it (0: pushed out of bone as pose_apply does) */
     uint32_t *nodes;        /**< soft nodes (tet vertices), cluster by cluster (Morton order at rest) */
     pose__push_cache *node_cache; /**< per node */
+    pose__push_anchor *node_anchor; /**< per node (pose__push_anchors) */
     pose__quiet node_quiet; /**< the nodes' clusters' last full passes */
     uint16_t *node_bone;    /**< per entry: the bone (index in bones) it lies within the margin
                                  of at rest, or UINT16_MAX */
@@ -179,6 +202,11 @@ float pose__push_distance(const pose__push_bone *b, const float *q, float max_di
 int pose__push_query(const pose__push *p, const pose__push_bone *b, const float *f, const float *x,
                      pose__push_cache *cache, float *signed_distance, float *closest, float *outward,
                      float *bound);
+/** The anchors a[i] of the points pos[3 idx[i]] (pos[3 i] when idx is
+ *  NULL), i < count, against the bones' frames of the pass; points
+ *  marked in skip (or NULL) need no search at all and join any group. */
+void pose__push_anchors(const pose__push *p, const pose__push_anchor *a, const float *pos, const uint32_t *idx,
+                        const uint8_t *skip, size_t count, pose__push_anchored *out);
 /** Bounding sphere (centre, radius) of the points pos[3 idx[i]] (pos[3 i]
  *  when idx is NULL), i in [begin, end). */
 void pose__push_sphere(const float *pos, const uint32_t *idx, size_t begin, size_t end, float *sphere);

@@ -490,54 +490,81 @@ static pose_status mark_reach(pose__push *p, const pose_state *st)
     return POSE_OK;
 }
 
-/* How far from its own bones a skin vertex riding rigidly with them must
- * be at rest to be left out of their search: the margin and what the
- * dynamics' bone springs let a bone node lag (0.15 mm measured) with room. */
-#define RIGID_CLEARANCE(margin) ((margin) + 0.001f)
+/* The joint carrying most of a point that blends tet vertices v[c] by
+ * share[c], c < count (a skin vertex: its tet's corners by its barycentric
+ * coordinates): the largest of its blended skinning weights. */
+static int heaviest_joint(const pose_rig *rig, const uint32_t *v, const float *share, int count)
+{
+    enum { MOST = 4 * POSE__MAX_INFLUENCES };
+    const unsigned K = rig->influences;
+    int joints[MOST], n = 0, best = -1;
+    float w[MOST], most = 0.0f;
+    for (int c = 0; c < count; c++)
+        for (unsigned k = 0; k < K && share[c] != 0.0f; k++) {
+            const int j = rig->weight_joints[K * (size_t)v[c] + k];
+            int e = 0;
+            while (e < n && joints[e] != j)
+                e++;
+            if (e == n) {
+                joints[n] = j;
+                w[n++] = 0.0f;
+            }
+            w[e] += share[c] * rig->weights[K * (size_t)v[c] + k];
+        }
+    for (int e = 0; e < n; e++)
+        if (w[e] > most) {
+            most = w[e];
+            best = joints[e];
+        }
+    return best;
+}
 
-/* Skin embedded in a bone tet whose four corners are weighted to that
- * tet's joint alone moves with that joint's bones rigidly with every
- * method (skinning, POSE_FEM's held bone tets, the dynamics' bone nodes on
- * their springs): its distance to them stays its rest distance, so those
- * bones are not searched for it (half the coarse body's skin lies in bone
- * tets: the pass's most frequent exact queries). */
-static pose_status mark_rigid(pose__push *p, const pose_state *st)
+/* A rest point's anchor (pose__push_anchor) on `joint`: its distance to the
+ * joint's bones, counted up to POSE__PUSH_REACH (farther: that much). */
+static void anchor_at(const pose__push *p, const float *x, int joint, pose__push_anchor *a)
+{
+    memcpy(a->rest, x, sizeof a->rest);
+    a->room = 0.0f;
+    a->joint = -1;
+    if (joint < 0 || (size_t)joint >= p->joint_count || p->joint_start[joint + 1] == p->joint_start[joint])
+        return;
+    float nearest = POSE__PUSH_REACH;
+    for (uint32_t e = p->joint_start[joint]; e < p->joint_start[joint + 1]; e++) {
+        const pose__push_bone *b = &p->bones[p->joint_bones[e]];
+        float e2 = 0.0f, c[3], o[3];
+        for (int d = 0; d < 3; d++) { /* the bone's box first */
+            const float g = x[d] < b->lo[d] ? b->lo[d] - x[d] : x[d] > b->hi[d] ? x[d] - b->hi[d] : 0.0f;
+            e2 += g * g;
+        }
+        if (e2 >= nearest * nearest)
+            continue;
+        const float sd = pose__push_distance(b, x, nearest, c, o);
+        if (sd < 0.0f) /* inside a bone at rest */
+            return;
+        nearest = sd < nearest ? sd : nearest;
+    }
+    if (nearest > p->margin) {
+        a->joint = joint;
+        a->room = nearest - p->margin;
+    }
+}
+
+/* The skin's anchors, in the pass's order. */
+static pose_status anchor_skin(pose__push *p, const pose_state *st)
 {
     const pose_rig *rig = st->rig;
-    p->own_joint = pose__alloc(&p->allocator, (p->vertex_count + 1) * sizeof *p->own_joint, POSE__ALIGN);
-    if (!p->own_joint)
+    p->anchor = pose__alloc(&p->allocator, (p->vertex_count + 1) * sizeof *p->anchor, POSE__ALIGN);
+    if (!p->anchor)
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu skin vertices", p->vertex_count);
-    const unsigned K = rig->influences;
     for (size_t i = 0; i < p->vertex_count; i++) {
         const uint32_t v = p->order[i];
-        p->own_joint[i] = -1;
         size_t t = 0;
         while (st->rt->tissue_offset[t + 1] <= v)
             t++;
         const pose__tissue *ts = &rig->tissues[t];
         const size_t local = v - st->rt->tissue_offset[t];
-        const uint32_t tet = ts->tet[local];
-        if (p->skip[i] || !rig->tet_labels || rig->tet_labels[tet] == 0)
-            continue;
-        const int joint = rig->tet_labels[tet] - 1;
-        int rigid = 1;
-        for (int c = 0; c < 4 && rigid; c++) {
-            const size_t tv = rig->tets[4 * (size_t)tet + (size_t)c];
-            float w = 0.0f;
-            for (unsigned k = 0; k < K; k++)
-                if (rig->weight_joints[K * tv + k] == joint)
-                    w += rig->weights[K * tv + k];
-            rigid = w >= 1.0f - 1e-6f;
-        }
-        const float *x = ts->positions + 3 * local;
-        for (size_t j = 0; j < p->bone_count && rigid; j++) {
-            const pose__push_bone *b = &p->bones[j];
-            float c[3], o[3];
-            if (b->joint == joint)
-                rigid = pose__push_distance(b, x, RIGID_CLEARANCE(p->margin), c, o) == INFINITY;
-        }
-        if (rigid)
-            p->own_joint[i] = joint;
+        const uint32_t *corners = rig->tets + 4 * (size_t)ts->tet[local];
+        anchor_at(p, ts->positions + 3 * local, heaviest_joint(rig, corners, ts->bary + 4 * local, 4), &p->anchor[i]);
     }
     return POSE_OK;
 }
@@ -600,7 +627,7 @@ void pose__push_release(pose__push *p)
     pose__free(a, p->order);
     pose__free(a, p->skip);
     pose__free(a, p->cache);
-    pose__free(a, p->own_joint);
+    pose__free(a, p->anchor);
     pose__free(a, p->reach);
     pose__free(a, p->frames);
     pose__free(a, p->bone_spheres);
@@ -615,6 +642,7 @@ void pose__push_release(pose__push *p)
     pose__quiet_release(&p->node_quiet, a);
     pose__free(a, p->nodes);
     pose__free(a, p->node_cache);
+    pose__free(a, p->node_anchor);
     pose__free(a, p->node_bone);
     pose__free(a, p->node_gap);
     pose__free(a, p->rest_count);
@@ -736,7 +764,7 @@ pose_status pose__push_build(pose__push *p, const pose_state *st, float margin)
     if (s != POSE_OK)
         return s;
     mark_rest_inside(p, st);
-    if ((s = mark_rigid(p, st)) != POSE_OK || (s = mark_reach(p, st)) != POSE_OK)
+    if ((s = anchor_skin(p, st)) != POSE_OK || (s = mark_reach(p, st)) != POSE_OK)
         return s;
     p->cover = pose__calloc(&p->allocator, sizeof *p->cover, POSE__ALIGN);
     if (!p->cover)
@@ -784,13 +812,14 @@ pose_status pose__push_build_nodes(pose__push *p, const pose_state *st)
     p->node_bone = pose__alloc(a, (nv + 1) * sizeof *p->node_bone, POSE__ALIGN);
     p->node_gap = pose__alloc(a, (nv + 1) * sizeof *p->node_gap, POSE__ALIGN);
     p->node_cache = pose__alloc(a, (nv + 1) * sizeof *p->node_cache, POSE__ALIGN);
+    p->node_anchor = pose__alloc(a, (nv + 1) * sizeof *p->node_anchor, POSE__ALIGN);
     p->rest_count = pose__alloc(a, nv + 1, POSE__ALIGN);
     p->rests = pose__alloc(a, POSE__PUSH_NODE_BONES * (nv + 1) * sizeof *p->rests, POSE__ALIGN);
     p->rest_on = pose__alloc(a, nv + 1, POSE__ALIGN);
     p->rest_stiff = pose__alloc(a, 6 * (nv + 1) * sizeof(float), POSE__ALIGN);
     p->rest_force = pose__alloc(a, 3 * (nv + 1) * sizeof(float), POSE__ALIGN);
     pose__morton *k = pose__alloc(a, (nv + 1) * sizeof *k, POSE__ALIGN);
-    if (!p->nodes || !p->node_bone || !p->node_gap || !p->node_cache || !p->rest_count || !p->rests ||
+    if (!p->nodes || !p->node_bone || !p->node_gap || !p->node_cache || !p->node_anchor || !p->rest_count || !p->rests ||
         !p->rest_on || !p->rest_stiff || !p->rest_force || !k) {
         pose__free(a, k);
         return pose__fail(POSE_ERR_OUT_OF_MEMORY, "out of memory for %zu nodes of the contact response", nv);
@@ -811,6 +840,8 @@ pose_status pose__push_build_nodes(pose__push *p, const pose_state *st)
         if (rest_gap(p, rest + 3 * (size_t)v, &p->node_bone[kept], &p->node_gap[kept]))
             continue;
         p->node_cache[kept].slot[0].bone = p->node_cache[kept].slot[1].bone = UINT32_MAX;
+        const float whole = 1.0f;
+        anchor_at(p, rest + 3 * (size_t)v, heaviest_joint(st->rig, &v, &whole, 1), &p->node_anchor[kept]);
         p->nodes[kept++] = v;
     }
     p->node_count = kept;

@@ -152,11 +152,12 @@ POSE_API const uint8_t *pose_contact_vertex_flags(const pose_contact *contact, i
  * called from the calling thread only, and the state's threads (about
  * 0.85 s on 2 threads for the bundled body;
  * pose_contact_response_stats.build_seconds); pose_apply allocates
- * nothing and runs the pass on the state's threads. A skin vertex embedded
- * in a bone tet that moves rigidly with its joint (all four corners
- * weighted to it alone) and lies farther than the margin plus 1 mm from
- * that joint's bones at rest is not searched against them: its distance
- * to them cannot change.
+ * nothing and runs the pass on the state's threads. Each skin vertex (and
+ * each node below) keeps its rest distance d to the bones of the joint that
+ * carries most of it (its largest skinning weight): while it strays less
+ * than d - margin from where that joint's motion alone would carry it,
+ * those bones are not searched for it (they are farther than the margin);
+ * a hand's skin among its 27 bones is most of what the pass would search.
  *
  * Dynamics (pose_step, pose.h): with the response on, each step also keeps
  * the tet mesh's soft nodes (vertices of soft tets only: bone nodes ride
